@@ -1,0 +1,60 @@
+//! Settings of the analysis core, already validated. The config module builds them from TOML,
+//! `analyze` from its command line; the core never parses text itself.
+
+use serde::Serialize;
+
+/// How the resonance band for envelope analysis is chosen (MODELS.md §3).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "method")]
+pub enum BandSelection {
+    /// The band of highest spectral kurtosis in the fast kurtogram.
+    Kurtogram,
+    /// The band of highest GK index (Gini index times kurtosis, seed 001).
+    GiniKurtosis,
+    /// A fixed band, in Hz.
+    Fixed { lo_hz: f64, hi_hz: f64 },
+}
+
+/// Everything the analysis core needs besides the samples, the sample rate and the bearing.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AnalysisSettings {
+    /// Length of one envelope-spectrum window, in seconds; rounded up to a power of two samples.
+    pub window_s: f64,
+    /// Overlap of successive windows, as a fraction of the window (0.5 = Welch's 50 %).
+    pub overlap: f64,
+    /// Rolling form: how many window spectra are averaged.
+    pub averages: usize,
+    /// How the resonance band is chosen.
+    pub band_selection: BandSelection,
+    /// Where a fault hypothesis exists, pick per hypothesis the candidate band whose envelope
+    /// spectrum shows that fault's harmonics best (fault-band signal-to-noise ratio).
+    pub refine_band_by_snr: bool,
+    /// Narrowest band the kurtogram may choose, in Hz. `None`: three times the highest fault
+    /// frequency, so that a band always holds the fault's sidebands.
+    pub min_band_hz: Option<f64>,
+    /// Relative search tolerance around each fault frequency (slip), e.g. 0.02 = ±2 %.
+    pub fault_tolerance: f64,
+    /// Harmonics of each fault frequency that count in its score.
+    pub harmonics: usize,
+    /// A diagnosis needs the best fault score to reach this value...
+    pub min_fault_score: f64,
+    /// ...and to exceed the runner-up by this factor; otherwise the diagnosis is `none`.
+    pub min_score_ratio: f64,
+}
+
+impl Default for AnalysisSettings {
+    fn default() -> Self {
+        AnalysisSettings {
+            window_s: 1.0,
+            overlap: 0.5,
+            averages: 8,
+            band_selection: BandSelection::GiniKurtosis,
+            refine_band_by_snr: true,
+            min_band_hz: None,
+            fault_tolerance: 0.02,
+            harmonics: 3,
+            min_fault_score: 30.0,
+            min_score_ratio: 2.0,
+        }
+    }
+}

@@ -1,0 +1,23 @@
+//! bearingd: watches a rolling-element bearing from its vibration.
+//!
+//! # Layout
+//!
+//! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
+//!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
+//!   cannot disagree.
+//! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies.
+//! - [`config`]: the TOML configuration, parsed raw then validated into typed settings, with
+//!   every problem reported at once.
+//! - [`recording`]: readers for recorded data (CWRU `.mat`, PRONOSTIA and plain CSV, IMS text,
+//!   WAV) that turn a file into samples plus what the file says about itself.
+//! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
+//! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
+//!
+//! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
+
+pub mod analysis;
+pub mod bearing;
+pub mod cli;
+pub mod config;
+pub mod plot;
+pub mod recording;
