@@ -147,6 +147,13 @@ impl PixelScale {
         let f = self.axis.fraction(value)?.clamp(-10.0, 11.0);
         Some(self.start + f * (self.end - self.start))
     }
+
+    /// Like [`PixelScale::to_pixel`], but values outside the axis land on its nearest end, so
+    /// lines never leave the plot (a log axis' floor catches everything below it).
+    pub fn to_pixel_clamped(&self, value: f64) -> Option<f64> {
+        let f = self.axis.fraction(value)?.clamp(0.0, 1.0);
+        Some(self.start + f * (self.end - self.start))
+    }
 }
 
 /// One tick: where it is and what it says.

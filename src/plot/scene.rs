@@ -3,7 +3,7 @@
 //! mapping, decimation) is made here once; the SVG and PNG renderers only translate primitives.
 
 use super::figure::{Color, Figure, HeatmapPanel, Panel, SpectrumPanel};
-use super::layout::{decimate_min_max, finite_range, Axis, PixelScale, Tick};
+use super::layout::{decimate_min_max, finite_range, format_number, Axis, PixelScale, Tick};
 use super::PlotError;
 
 /// Width of one glyph cell at text scale 1, in pixels (the 8×8 bitmap font; the SVG uses a
@@ -150,6 +150,13 @@ fn fit_text(text: &str, scale: u32, max_width: f64) -> String {
     short
 }
 
+/// The unit in an axis label written as "name (unit)", e.g. "Hz" in "frequency (Hz)".
+fn unit_in(label: &str) -> Option<&str> {
+    let inner = label.trim_end().strip_suffix(')')?;
+    let unit = &inner[inner.rfind('(')? + 1..];
+    (!unit.trim().is_empty()).then(|| unit.trim())
+}
+
 /// Half-pixel aligned coordinate so that a 1 px line covers exactly one pixel row or column.
 fn crisp(v: f64) -> f64 {
     v.floor() + 0.5
@@ -267,37 +274,37 @@ struct PlacedLabel {
     marker_x: f64,
 }
 
-/// Places marker labels (centred on their markers, kept inside the figure) in the lowest row
-/// where they do not overlap a previous label; returns them and the number of rows used.
-fn stagger_labels(mut labels: Vec<(f64, String, Color)>) -> (Vec<PlacedLabel>, usize) {
+/// Places marker labels centred on their markers (kept inside the figure), each in the lowest
+/// row where it overlaps no label placed before it. Labels are taken in the caller's order, so
+/// list fundamentals before harmonics: when all rows are taken at a spot, later labels there
+/// are left out (their marker lines are still drawn). Returns the labels and the rows used.
+fn stagger_labels(labels: Vec<(f64, String, Color)>) -> (Vec<PlacedLabel>, usize) {
     const GAP: f64 = 6.0;
-    labels.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut row_ends = [f64::NEG_INFINITY; MAX_MARKER_ROWS];
-    let mut placed = Vec::with_capacity(labels.len());
-    let mut rows_used = 0;
-    for (marker_x, label, color) in labels {
+    /// Beyond this many labels the top of the plot is full anyway.
+    const MAX_LABELS_TRIED: usize = 256;
+    let mut rows: [Vec<(f64, f64)>; MAX_MARKER_ROWS] = Default::default();
+    let mut placed = Vec::new();
+    for (marker_x, label, color) in labels.into_iter().take(MAX_LABELS_TRIED) {
         let text = fit_text(&label, TEXT_SCALE, 160.0);
         let width = text_width(&text, TEXT_SCALE);
         let left = (marker_x - width / 2.0).clamp(4.0, FIGURE_WIDTH - 4.0 - width);
-        let row = row_ends
-            .iter()
-            .position(|&end| end + GAP <= left)
-            .unwrap_or_else(|| {
-                // No free row: take the one whose last label ends earliest.
-                (0..MAX_MARKER_ROWS)
-                    .min_by(|&a, &b| row_ends[a].total_cmp(&row_ends[b]))
-                    .unwrap_or(0)
+        let right = left + width;
+        let free = |row: &Vec<(f64, f64)>| {
+            row.iter()
+                .all(|&(l, r)| right + GAP <= l || left >= r + GAP)
+        };
+        if let Some(row) = rows.iter().position(free) {
+            rows[row].push((left, right));
+            placed.push(PlacedLabel {
+                x: left,
+                text,
+                row,
+                color,
+                marker_x,
             });
-        row_ends[row] = left + width;
-        rows_used = rows_used.max(row + 1);
-        placed.push(PlacedLabel {
-            x: left,
-            text,
-            row,
-            color,
-            marker_x,
-        });
+        }
     }
+    let rows_used = rows.iter().filter(|r| !r.is_empty()).count();
     (placed, rows_used)
 }
 
@@ -428,7 +435,7 @@ fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<Item>) {
     for (series, points) in panel.series.iter().zip(&thinned) {
         let pixels: Vec<(f64, f64)> = points
             .iter()
-            .filter_map(|&(x, y)| Some((x_scale.to_pixel(x)?, y_scale.to_pixel(y)?)))
+            .filter_map(|&(x, y)| Some((x_scale.to_pixel(x)?, y_scale.to_pixel_clamped(y)?)))
             .collect();
         match pixels.as_slice() {
             [] => {}
@@ -793,13 +800,14 @@ fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item>) {
             let from = band * c as f64;
             let to = band * (c + 1) as f64;
             let value = row.values[c];
+            let unit = unit_in(&panel.x_label).map_or(String::new(), |u| format!(" {u}"));
             let caption = format!(
-                "outlined: row {}, {}-{}, {} = {}",
+                "outlined: row {}, {}-{}{unit}, {} = {}",
                 row.label,
-                super::layout::format_number(from, band / 10.0),
-                super::layout::format_number(to, band / 10.0),
+                format_number(from, band / 10.0),
+                format_number(to, band / 10.0),
                 panel.value_label,
-                super::layout::format_number(value, value.abs() / 100.0),
+                format_number(value, value.abs() / 100.0),
             );
             items.push(text(
                 area.right,
@@ -890,13 +898,21 @@ mod tests {
     fn labels_that_collide_go_to_new_rows() {
         let (placed, rows) = stagger_labels(vec![
             (100.0, "BPFO".into(), Color::BLUE),
-            (110.0, "BPFI".into(), Color::BLUE),
             (300.0, "2×BPFO".into(), Color::BLUE),
+            (110.0, "BPFI".into(), Color::BLUE),
         ]);
         assert_eq!(rows, 2);
-        assert_eq!(placed[0].row, 0);
-        assert_eq!(placed[1].row, 1);
-        assert_eq!(placed[2].row, 0);
+        let rows_by_label: Vec<_> = placed.iter().map(|p| (p.text.as_str(), p.row)).collect();
+        assert_eq!(rows_by_label, [("BPFO", 0), ("2×BPFO", 0), ("BPFI", 1)]);
+    }
+
+    #[test]
+    fn labels_beyond_the_rows_are_left_out() {
+        let crowd = (0..20).map(|i| (500.0 + f64::from(i), format!("L{i}"), Color::BLUE));
+        let (placed, rows) = stagger_labels(crowd.collect());
+        assert_eq!(rows, MAX_MARKER_ROWS);
+        assert_eq!(placed.len(), MAX_MARKER_ROWS);
+        assert_eq!(placed[0].text, "L0");
     }
 
     #[test]
@@ -908,6 +924,14 @@ mod tests {
         assert!(spans
             .iter()
             .any(|&(a, b, v)| (a..b).contains(&7_777) && v == 5.0));
+    }
+
+    #[test]
+    fn units_come_from_axis_labels() {
+        assert_eq!(unit_in("frequency (Hz)"), Some("Hz"));
+        assert_eq!(unit_in("frequency"), None);
+        assert_eq!(unit_in("x ()"), None);
+        assert_eq!(unit_in(")"), None);
     }
 
     #[test]
