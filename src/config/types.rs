@@ -1,0 +1,245 @@
+//! The validated configuration. Every value here has passed its checks: consumers use it as
+//! is, without re-checking ranges or parsing strings.
+
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use crate::analysis::AnalysisSettings;
+use crate::bearing::BearingGeometry;
+
+/// A complete, validated configuration.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Config {
+    /// At least one sensor; ids, CAN nodes and iceoryx2 services are unique.
+    pub sensors: Vec<SensorConfig>,
+    /// Settings of the analysis core (`[analysis]`).
+    pub analysis: AnalysisSettings,
+    /// How often the resonance band is chosen again, in seconds (`analysis.band_period_s`).
+    /// Kept here because [`AnalysisSettings`] has no field for it yet.
+    pub band_period_s: f64,
+    /// The signal-model twin (`[twin]`).
+    pub twin: TwinConfig,
+    /// Fault-flag thresholds and the health baseline (`[thresholds]`).
+    pub thresholds: ThresholdConfig,
+    /// Where results go (`[outputs]`).
+    pub outputs: OutputConfig,
+}
+
+/// One accelerometer (`[[sensors]]`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SensorConfig {
+    /// Unique, `[a-z0-9_-]{1,32}`; names MCAP channels and iceoryx2 services.
+    pub id: String,
+    /// Where the samples come from, with that transport's settings.
+    pub transport: Transport,
+    /// Sample rate, in Hz; in (0, 1 000 000].
+    pub sample_rate_hz: f64,
+    /// Acceleration of one integer count on the wire, in g; positive.
+    pub scale_g_per_count: f64,
+    /// 1 to 3 distinct axis names, in the order the sensor sends them.
+    pub axes: Vec<String>,
+    /// The monitored bearing, resolved from the catalog or from custom geometry.
+    pub bearing: BearingGeometry,
+    /// How the shaft speed is known.
+    pub speed: Speed,
+}
+
+impl SensorConfig {
+    /// Half the sample rate, in Hz.
+    pub fn nyquist_hz(&self) -> f64 {
+        self.sample_rate_hz / 2.0
+    }
+}
+
+/// Where a sensor's samples come from.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Transport {
+    /// The in-process simulated sensor node.
+    Sim(SimConfig),
+    /// SocketCAN.
+    Can(CanConfig),
+    /// iceoryx2 shared memory, from a local acquisition process.
+    Shm(ShmConfig),
+}
+
+/// `[sensors.can]`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct CanConfig {
+    /// SocketCAN interface, e.g. `can0`; at most 15 bytes (the kernel's limit).
+    pub interface: String,
+    /// The sensor node's id on the bus, 0..=15.
+    pub node_id: u8,
+    /// CAN FD frames instead of classic CAN.
+    pub fd: bool,
+}
+
+/// `[sensors.shm]`.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct ShmConfig {
+    /// iceoryx2 service carrying the samples; starts with `bearingd/`.
+    pub service: String,
+}
+
+/// `[sensors.sim]`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SimConfig {
+    /// The fault the simulated bearing develops.
+    pub fault: SimFault,
+    /// Sample time at which the fault appears, in seconds; >= 0.
+    pub onset_s: f64,
+    /// Impact amplitude relative to the model's nominal fault, in [0, 100]; 0 = no impacts.
+    pub severity: f64,
+    /// Standard deviation of the added white noise, in g; in [0, 100].
+    pub noise_g: f64,
+    /// Seed of the simulator's random numbers (noise, slip jitter).
+    pub seed: u64,
+}
+
+impl Default for SimConfig {
+    fn default() -> Self {
+        SimConfig {
+            fault: SimFault::Outer,
+            onset_s: 30.0,
+            severity: 1.0,
+            noise_g: 0.05,
+            seed: 1,
+        }
+    }
+}
+
+/// Which fault the simulator produces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SimFault {
+    None,
+    Outer,
+    Inner,
+    Ball,
+}
+
+/// How a sensor's shaft speed is known (`[sensors.speed]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "source", rename_all = "snake_case")]
+pub enum Speed {
+    /// A constant speed, in revolutions per minute; in (0, 100 000).
+    Fixed { rpm: f64 },
+}
+
+impl Speed {
+    /// The shaft rotation frequency, in Hz.
+    pub fn shaft_hz(&self) -> f64 {
+        match self {
+            Speed::Fixed { rpm } => rpm / 60.0,
+        }
+    }
+}
+
+/// `[twin]`: the signal-model twin's re-fit schedule.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct TwinConfig {
+    /// Sample time between re-fits, in seconds.
+    pub refit_period_s: f64,
+    /// Length of signal each fit uses, in seconds.
+    pub window_s: f64,
+}
+
+impl Default for TwinConfig {
+    fn default() -> Self {
+        TwinConfig {
+            refit_period_s: 10.0,
+            window_s: 1.0,
+        }
+    }
+}
+
+/// `[thresholds]`: fault flags (ok, watch, alarm) with hysteresis, and the health baseline.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ThresholdConfig {
+    /// Fault score at which a flag rises to watch.
+    pub watch_score: f64,
+    /// Fault score at which a flag rises to alarm; above `watch_score`.
+    pub alarm_score: f64,
+    /// A flag falls back once its score is below `clear_ratio` × its threshold; in (0, 1).
+    pub clear_ratio: f64,
+    /// How long the score must stay above a threshold before the flag rises, in seconds
+    /// (the daemon converts it to samples).
+    pub on_delay_s: f64,
+    /// How long the score must stay below the clear level before the flag falls, in seconds.
+    pub off_delay_s: f64,
+    /// Windows that form the health-stage baseline; at least 5.
+    pub baseline_windows: usize,
+    /// Standard deviations above the baseline that mark a change of health stage.
+    pub sigma: f64,
+}
+
+impl Default for ThresholdConfig {
+    fn default() -> Self {
+        ThresholdConfig {
+            watch_score: 15.0,
+            alarm_score: 30.0,
+            clear_ratio: 0.8,
+            on_delay_s: 5.0,
+            off_delay_s: 30.0,
+            baseline_windows: 30,
+            sigma: 3.0,
+        }
+    }
+}
+
+/// `[outputs]`: files, services and status.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct OutputConfig {
+    /// Persistent state (baselines, band choices).
+    pub state_dir: PathBuf,
+    /// MCAP log files.
+    pub mcap_dir: PathBuf,
+    /// An MCAP file is closed and a new one started at this size, in MiB (2^20 bytes).
+    pub mcap_max_file_mb: u64,
+    /// ...or at this age, in seconds.
+    pub mcap_max_file_s: f64,
+    /// Disk space MCAP files may use before the oldest are deleted, in MiB; at least twice
+    /// `mcap_max_file_mb` (one open file plus one finished).
+    pub mcap_disk_budget_mb: u64,
+    /// iceoryx2 service for fault alerts; starts with `bearingd/`.
+    pub alerts_service: String,
+    /// iceoryx2 root directory; absolute, not under `/tmp` or `/var/tmp`.
+    pub iceoryx2_root: PathBuf,
+    /// How often status is reported (systemd STATUS, stdout), in seconds.
+    pub status_interval_s: f64,
+}
+
+impl OutputConfig {
+    /// `mcap_max_file_mb` in bytes.
+    pub fn mcap_max_file_bytes(&self) -> u64 {
+        self.mcap_max_file_mb.saturating_mul(1 << 20)
+    }
+
+    /// `mcap_disk_budget_mb` in bytes.
+    pub fn mcap_disk_budget_bytes(&self) -> u64 {
+        self.mcap_disk_budget_mb.saturating_mul(1 << 20)
+    }
+}
+
+impl Default for OutputConfig {
+    fn default() -> Self {
+        OutputConfig {
+            state_dir: PathBuf::from("/var/lib/bearingd"),
+            mcap_dir: PathBuf::from("/var/log/bearingd"),
+            mcap_max_file_mb: 256,
+            mcap_max_file_s: 3600.0,
+            mcap_disk_budget_mb: 4096,
+            alerts_service: "bearingd/alerts".to_string(),
+            iceoryx2_root: PathBuf::from("/run/bearingd/iceoryx2"),
+            status_interval_s: 5.0,
+        }
+    }
+}
+
+/// Defaults of `[analysis]` keys that [`AnalysisSettings`] does not hold.
+pub(crate) const DEFAULT_BAND_PERIOD_S: f64 = 60.0;
+/// Defaults of sensor keys.
+pub(crate) const DEFAULT_SCALE_G_PER_COUNT: f64 = 0.000488;
+pub(crate) const DEFAULT_AXIS: &str = "radial";
+pub(crate) const DEFAULT_CAN_INTERFACE: &str = "can0";
