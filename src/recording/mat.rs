@@ -154,26 +154,39 @@ fn elements(
     Ok(out)
 }
 
-/// The name of an uncompressed matrix element, read straight from its bytes (for messages about
-/// elements `matfile` cannot decode).
-fn element_name(el: &[u8], endian: Endian) -> Option<String> {
+/// What an uncompressed matrix element says about itself, read straight from its bytes: its
+/// name (for messages about elements `matfile` cannot decode) and whether its dimensions fit
+/// in an `i32` product (`matfile` multiplies them unchecked, which panics in debug builds).
+struct ElementHeader {
+    name: String,
+    dims_ok: bool,
+}
+
+fn element_header(el: &[u8], endian: Endian) -> Option<ElementHeader> {
     // Tag (8), array flags (16), then the dimensions and the name sub-elements.
     let mut at = 24;
-    for step in 0..2 {
+    let mut parts = [(0usize, 0usize); 2];
+    for part in &mut parts {
         let tag = u32_at(el, at, endian)?;
         let (data_at, len, next) = if tag & 0xFFFF_0000 != 0 {
             (at + 4, (tag >> 16) as usize, at + 8)
         } else {
             let len = u32_at(el, at + 4, endian)? as usize;
-            (at + 8, len, at + 8 + len.next_multiple_of(8))
+            (at + 8, len, at.checked_add(8 + len.next_multiple_of(8))?)
         };
-        if step == 1 {
-            let name = el.get(data_at..data_at.checked_add(len)?)?;
-            return Some(String::from_utf8_lossy(name).into_owned());
-        }
+        *part = (data_at, len);
         at = next;
     }
-    None
+    let [(dims_at, dims_len), (name_at, name_len)] = parts;
+    let name = el.get(name_at..name_at.checked_add(name_len)?)?;
+    let dims_ok = (0..dims_len / 4)
+        .map(|k| u32_at(el, dims_at + 4 * k, endian).map(|d| d as i32))
+        .try_fold(1i32, |acc, d| acc.checked_mul(d?).filter(|p| *p >= 0))
+        .is_some();
+    Some(ElementHeader {
+        name: String::from_utf8_lossy(name).into_owned(),
+        dims_ok,
+    })
 }
 
 /// What a file holds: the numeric arrays, and descriptions of the variables that are not.
@@ -202,13 +215,18 @@ fn decode(path: &Path, bytes: &[u8]) -> Result<Contents, RecordingError> {
         let mut buf = Vec::with_capacity(HEADER_LEN + el.bytes.len());
         buf.extend_from_slice(&bytes[..HEADER_LEN]);
         buf.extend_from_slice(&bytes[el.bytes.clone()]);
-        let what = match (
-            el.compressed,
-            element_name(&bytes[el.bytes.clone()], endian),
-        ) {
-            (false, Some(name)) => format!("'{name}'"),
-            _ => format!("at byte {}", el.offset),
+        let header = element_header(&bytes[el.bytes.clone()], endian).filter(|_| !el.compressed);
+        let what = match &header {
+            Some(h) => format!("'{}'", h.name),
+            None => format!("at byte {}", el.offset),
         };
+        if header.as_ref().is_some_and(|h| !h.dims_ok) {
+            warnings.push(format!(
+                "skipped the variable {what}: its dimensions are invalid"
+            ));
+            others.push(format!("{what} (cannot be decoded)"));
+            continue;
+        }
         match catch_unwind(AssertUnwindSafe(|| matfile::MatFile::parse(buf.as_slice()))) {
             Ok(Ok(file)) if !file.arrays().is_empty() => {
                 arrays.extend(file.arrays().iter().cloned())

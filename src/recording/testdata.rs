@@ -4,6 +4,7 @@
 //! that needs one must say loudly when it is missing, and must fail on CI where a silent skip
 //! would hide that nothing was tested.
 
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -11,7 +12,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 /// if set, else `CARGO_MANIFEST_DIR/../shared/data`.
 ///
 /// When it is missing: with `CI=true` this panics (the test fails) naming the data set and
-/// where it was looked for; otherwise it prints a loud notice and returns `None` so the test
+/// where it was looked for; otherwise it prints a loud notice (past the test harness's capture) and returns `None` so the test
 /// can return early.
 pub fn shared_data_dir(kind: &str) -> Option<PathBuf> {
     let (base, source) = match std::env::var_os("BEARINGD_DATA_DIR") {
@@ -33,7 +34,12 @@ pub fn shared_data_dir(kind: &str) -> Option<PathBuf> {
     if ci {
         panic!("{message}");
     }
-    eprintln!("\n**********\nSKIPPING: {message}\n**********\n");
+    // Written to the stderr handle directly: the test harness captures eprintln! output of
+    // passing tests, and this notice must be seen.
+    let _ = writeln!(
+        std::io::stderr(),
+        "\n**********\nSKIPPING: {message}\n**********\n"
+    );
     None
 }
 
