@@ -127,12 +127,13 @@ fn elements(
                 detail: format!("the data element tag at byte {off} is not valid here"),
             });
         }
-        let end = off + 8 + size as usize;
+        let end = off.saturating_add(8).saturating_add(size as usize);
         if end > bytes.len() {
-            return Err(truncated(
-                format!("the data element at byte {off} ({size} bytes of data)"),
-                end,
-            ));
+            let what = match element_header(&bytes[off..], endian) {
+                Some(h) if kind == MI_MATRIX => format!("variable '{}' (at byte {off})", h.name),
+                _ => format!("the data element at byte {off}"),
+            };
+            return Err(truncated(what, end));
         }
         match kind {
             MI_MATRIX | MI_COMPRESSED => out.push(Element {
@@ -148,7 +149,7 @@ fn elements(
         off = if kind == MI_COMPRESSED {
             end
         } else {
-            end.next_multiple_of(8)
+            end.checked_next_multiple_of(8).unwrap_or(end)
         };
     }
     Ok(out)
@@ -172,7 +173,8 @@ fn element_header(el: &[u8], endian: Endian) -> Option<ElementHeader> {
             (at + 4, (tag >> 16) as usize, at + 8)
         } else {
             let len = u32_at(el, at + 4, endian)? as usize;
-            (at + 8, len, at.checked_add(8 + len.next_multiple_of(8))?)
+            let next = at.checked_add(len.checked_next_multiple_of(8)?.checked_add(8)?)?;
+            (at + 8, len, next)
         };
         *part = (data_at, len);
         at = next;
@@ -180,7 +182,7 @@ fn element_header(el: &[u8], endian: Endian) -> Option<ElementHeader> {
     let [(dims_at, dims_len), (name_at, name_len)] = parts;
     let name = el.get(name_at..name_at.checked_add(name_len)?)?;
     let dims_ok = (0..dims_len / 4)
-        .map(|k| u32_at(el, dims_at + 4 * k, endian).map(|d| d as i32))
+        .map(|k| u32_at(el, dims_at.checked_add(4 * k)?, endian).map(|d| d as i32))
         .try_fold(1i32, |acc, d| acc.checked_mul(d?).filter(|p| *p >= 0))
         .is_some();
     Some(ElementHeader {

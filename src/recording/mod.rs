@@ -109,7 +109,7 @@ pub enum RecordingError {
     UnknownFormat { path: PathBuf, reason: String },
     #[error("{path}: not a MATLAB v5 file: {reason}")]
     NotMatlab { path: PathBuf, reason: String },
-    #[error("{path}: file truncated: {what} needs {expected} bytes but the file has only {present}; the copy is incomplete, fetch or copy the file again")]
+    #[error("{path}: file truncated: {what} ends at byte {expected} but the file has only {present} bytes; the copy is incomplete, fetch or copy the file again")]
     Truncated {
         path: PathBuf,
         what: String,

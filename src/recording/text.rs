@@ -159,10 +159,8 @@ pub(super) fn read_column(
     col: usize,
 ) -> Result<Column, RecordingError> {
     let n_fields = layout.names.len();
-    let name = &layout.names[col.min(n_fields.saturating_sub(1))];
-    // A rough capacity from the first line's length avoids regrowing on large files.
-    let guess = text.len() / text.lines().next().map_or(1, |l| l.len().max(1) + 1);
-    let mut samples = Vec::with_capacity(guess + 1);
+    let name = layout.names.get(col).cloned().unwrap_or_default();
+    let mut samples = Vec::new();
     let mut warnings = Vec::new();
     let mut bad: Option<(usize, usize)> = None; // (sample index, line)
     let mut bad_count = 0usize;
@@ -216,7 +214,7 @@ pub(super) fn read_column(
     if let Some((index, line)) = bad {
         return Err(RecordingError::NonFinite {
             path: path.to_path_buf(),
-            channel: name.clone(),
+            channel: name,
             index,
             count: bad_count,
             at: format!(" (line {line})"),

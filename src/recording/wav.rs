@@ -64,7 +64,7 @@ fn read_inner(
     let names = names(spec.channels);
     let ch = match selector {
         None => 0,
-        Some(wanted) => pick_by_name_or_index(path, "channel", wanted, &names, true)?,
+        Some(wanted) => pick_by_name_or_index(path, "channel", wanted, &names, false)?,
     };
     let declared = reader.duration() as usize;
     let block = usize::from(spec.bits_per_sample.div_ceil(8)).max(1) * n;
