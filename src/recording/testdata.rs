@@ -1,0 +1,58 @@
+//! Test helpers shared by unit and integration tests (hidden; not part of the product API).
+//!
+//! The real data sets live outside the repository (`../shared/data`, never committed), so a test
+//! that needs one must say loudly when it is missing, and must fail on CI where a silent skip
+//! would hide that nothing was tested.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// The directory of one shared data set (`cwru`, `femto`, `ims`): under `$BEARINGD_DATA_DIR`
+/// if set, else `CARGO_MANIFEST_DIR/../shared/data`.
+///
+/// When it is missing: with `CI=true` this panics (the test fails) naming the data set and
+/// where it was looked for; otherwise it prints a loud notice (past the test harness's capture) and returns `None` so the test
+/// can return early.
+pub fn shared_data_dir(kind: &str) -> Option<PathBuf> {
+    let (base, source) = match std::env::var_os("BEARINGD_DATA_DIR") {
+        Some(dir) => (PathBuf::from(dir), "$BEARINGD_DATA_DIR"),
+        None => (
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
+            "the default CARGO_MANIFEST_DIR/../shared/data",
+        ),
+    };
+    let dir = base.join(kind);
+    if dir.is_dir() {
+        return Some(dir);
+    }
+    let message = format!(
+        "data set '{kind}' is missing: looked for {} (from {source}); set BEARINGD_DATA_DIR to the directory that holds cwru/, femto/ and ims/",
+        dir.display()
+    );
+    let ci = std::env::var("CI").is_ok_and(|v| v.eq_ignore_ascii_case("true") || v == "1");
+    if ci {
+        panic!("{message}");
+    }
+    // Written to the stderr handle directly: the test harness captures eprintln! output of
+    // passing tests, and this notice must be seen.
+    let _ = writeln!(
+        std::io::stderr(),
+        "\n**********\nSKIPPING: {message}\n**********\n"
+    );
+    None
+}
+
+/// A fresh, empty scratch directory under the system temp dir, unique per process and call.
+///
+/// # Panics
+/// When the directory cannot be created (tests only).
+pub fn scratch_dir(test: &str) -> PathBuf {
+    static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("bearingd-{test}-{}-{n}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir)
+        .unwrap_or_else(|e| panic!("cannot create scratch dir {}: {e}", dir.display()));
+    dir
+}
