@@ -22,10 +22,13 @@
 //! - [`frame`]: the decoded frames ([`Frame`], [`DataFrame`], [`Metadata`], [`SpeedFrame`]) and
 //!   the receiver's [`MetadataAssembler`].
 //! - [`codec`]: [`encode`] and [`decode`], with [`EncodeError`] and [`DecodeError`].
+//! - [`node`]: [`SensorNode`], the sampling state machine of a node: samples in, frames out,
+//!   through a bounded queue whose overflow is counted.
 
 pub mod codec;
 pub mod frame;
 pub mod id;
+pub mod node;
 
 pub use codec::{decode, encode, DecodeError, EncodeError};
 pub use frame::{
@@ -33,3 +36,4 @@ pub use frame::{
     MetadataPage, NodeInfo, SpeedFrame, SpeedSource, StreamPage, PROTOCOL_VERSION,
 };
 pub use id::{CanId, MessageKind};
+pub use node::{ConfigError, NodeConfig, NodeStats, PushError, Pushed, SensorNode};
