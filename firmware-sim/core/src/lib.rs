@@ -24,11 +24,13 @@
 //! - [`codec`]: [`encode`] and [`decode`], with [`EncodeError`] and [`DecodeError`].
 //! - [`node`]: [`SensorNode`], the sampling state machine of a node: samples in, frames out,
 //!   through a bounded queue whose overflow is counted.
+//! - [`tracker`]: [`SequenceTracker`], the receiver's per-(node, axis) loss and restart detector.
 
 pub mod codec;
 pub mod frame;
 pub mod id;
 pub mod node;
+pub mod tracker;
 
 pub use codec::{decode, encode, DecodeError, EncodeError};
 pub use frame::{
@@ -37,3 +39,4 @@ pub use frame::{
 };
 pub use id::{CanId, MessageKind};
 pub use node::{ConfigError, NodeConfig, NodeStats, PushError, Pushed, SensorNode};
+pub use tracker::{Observation, SequenceTracker, TrackerCounters};
