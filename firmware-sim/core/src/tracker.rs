@@ -33,8 +33,8 @@
 //! # Limits
 //!
 //! A forward jump is unambiguous only below half the index width: 2^23 samples on classic
-//! frames, 2^31 on FD. A classic bus carries at most about 16 000 samples/s (2 per frame, about
-//! 8 000 frames/s at 1 Mbit/s), so 2^23 samples take more than 8 minutes; the daemon's
+//! frames, 2^31 on FD. A classic bus carries at most about 18 000 samples/s (2 per frame, about
+//! 9 000 frames/s at 1 Mbit/s), so 2^23 samples take more than 7.5 minutes; the daemon's
 //! stale-stream deadline, far shorter, calls [`SequenceTracker::resync`] first. The classic
 //! index is extended from its low 24 bits, so the 64-bit positions of a classic stream equal the
 //! node's own counter only if the tracker saw the stream from the node's start; otherwise they
