@@ -15,6 +15,54 @@
 //! only in the daemon's config. The byte layouts are written down in `docs/WIRE_FORMAT.md` and as
 //! a DBC file, `config/bearingd.dbc`, that standard CAN tools load.
 //!
+//! # Example: node to receiver
+//!
+//! ```
+//! use bearing_wire::{
+//!     decode, encode, AxisSet, CanId, FirmwareVersion, Frame, FrameKind, MessageKind,
+//!     MetadataAssembler, NodeConfig, Observation, SensorNode, SequenceTracker,
+//! };
+//!
+//! // The node: one axis, CAN FD frames, metadata once per second.
+//! let mut node: SensorNode<32> = SensorNode::new(NodeConfig {
+//!     node: 2,
+//!     axes: AxisSet::from_axes(&[0]).unwrap(),
+//!     data_kind: FrameKind::Fd,
+//!     sample_rate_hz: 25_600,
+//!     scale_g_per_count: 1.0 / 4096.0,
+//!     firmware: FirmwareVersion { major: 1, minor: 0, patch: 0 },
+//!     metadata_period_samples: 25_600,
+//! })
+//! .unwrap();
+//! let pushed = node.push_samples(0, &[100; 56]).unwrap();
+//! assert_eq!(pushed.dropped, 0);
+//!
+//! // The receiver: decode every frame; track each (node, axis) stream.
+//! let mut info = MetadataAssembler::new();
+//! let mut tracker = SequenceTracker::new(FrameKind::Fd);
+//! let mut bytes = [0u8; 64];
+//! while let Some(frame) = node.pop_frame() {
+//!     let (id, len) = encode(&frame, FrameKind::Fd, &mut bytes).unwrap();
+//!     // ...the bus...
+//!     match decode(u32::from(id), &bytes[..len]).unwrap() {
+//!         Frame::Metadata(m) => {
+//!             info.apply(&m);
+//!         }
+//!         Frame::Data(d) => {
+//!             let obs = tracker.observe(&d);
+//!             assert!(matches!(obs, Observation::Start { .. } | Observation::InOrder { .. }));
+//!         }
+//!         Frame::Speed(_) => {}
+//!     }
+//! }
+//! assert_eq!(info.info().unwrap().stream.sample_rate_hz, 25_600);
+//! assert_eq!(tracker.next_sample(), Some(56));
+//! assert!(matches!(
+//!     CanId::parse(0x102).unwrap().message,
+//!     MessageKind::Data { kind: FrameKind::Fd, axis: 0 }
+//! ));
+//! ```
+//!
 //! # Layout
 //!
 //! - [`id`]: the 11-bit CAN identifier plan (which id carries which frame, and why in that
