@@ -10,7 +10,9 @@
 //!   every problem reported at once.
 //! - [`recording`]: readers for recorded data (CWRU `.mat`, PRONOSTIA and plain CSV, IMS text,
 //!   WAV) that turn a file into samples plus what the file says about itself.
+//! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
+//! - [`twin`]: the signal-model twin of a defective bearing (simulation now, fitting later).
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
@@ -21,3 +23,5 @@ pub mod cli;
 pub mod config;
 pub mod plot;
 pub mod recording;
+pub mod report;
+pub mod twin;

@@ -4,7 +4,25 @@
 //! replay and `bearingd analyze` drive the same code with samples in sample time, so their
 //! results cannot disagree. Buffers are owned and preallocated; the rolling path does not
 //! allocate per hop.
+//!
+//! - [`envelope`]: squared-envelope spectrum, batch (Welch) and rolling.
+//! - [`kurtogram`]: the band tree, spectral kurtosis, GK index, per-band spectra.
+//! - [`fault_bands`]: fault-frequency scores with slip tolerance and sidebands.
+//! - [`diagnosis`]: the verdict and its confidence.
+//! - [`indicators`]: RMS, peak, crest factor, kurtosis.
+//! - [`record`]: all of the above over one whole record (`bearingd analyze`).
 
+pub mod band;
+pub mod diagnosis;
+pub mod envelope;
+pub mod fault_bands;
+pub mod indicators;
+pub mod kurtogram;
+pub mod record;
 pub mod settings;
 
+pub use band::Band;
+pub use diagnosis::{Diagnosis, Verdict};
+pub use fault_bands::{FaultKind, FaultScore};
+pub use record::{analyze_record, AnalysisError, RecordAnalysis};
 pub use settings::{AnalysisSettings, BandSelection};

@@ -53,7 +53,7 @@ impl Default for AnalysisSettings {
             min_band_hz: None,
             fault_tolerance: 0.02,
             harmonics: 3,
-            min_fault_score: 30.0,
+            min_fault_score: 15.0,
             min_score_ratio: 2.0,
         }
     }

@@ -1,4 +1,79 @@
-//! placeholder, being written
-pub fn main() -> std::process::ExitCode {
-    std::process::ExitCode::SUCCESS
+//! The `bearingd` command line. The only place that prints, chooses exit codes, or turns
+//! typed errors into messages for people (DESIGN.md "Errors": `anyhow`-style handling lives
+//! only at this edge).
+//!
+//! Exit codes: 0 success, 2 bad input (a file, an option or a config that cannot be used; the
+//! message names it and says how to fix it), 1 anything else.
+
+mod analyze;
+mod config_cmd;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// An error on its way to the user: the message and the exit code.
+#[derive(Debug)]
+pub struct CliError {
+    pub message: String,
+    pub code: u8,
+}
+
+impl CliError {
+    pub fn input(message: impl std::fmt::Display) -> Self {
+        CliError {
+            message: message.to_string(),
+            code: 2,
+        }
+    }
+
+    pub fn failure(message: impl std::fmt::Display) -> Self {
+        CliError {
+            message: message.to_string(),
+            code: 1,
+        }
+    }
+}
+
+#[derive(Parser)]
+#[command(
+    name = "bearingd",
+    version,
+    about = "Watches a rolling-element bearing from its vibration: envelope spectrum, fault scores, diagnosis."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Diagnose a recording (CWRU .mat, PRONOSTIA/IMS/plain CSV, WAV) or the built-in demo.
+    Analyze(analyze::AnalyzeArgs),
+    /// Check a configuration file; lists every problem with its key and how to fix it.
+    Validate {
+        /// The TOML file to check.
+        file: std::path::PathBuf,
+    },
+    /// Configuration helpers.
+    Config {
+        #[command(subcommand)]
+        action: config_cmd::ConfigAction,
+    },
+}
+
+/// Parses the command line, runs the command, prints errors, returns the exit code.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Analyze(args) => analyze::run(&args),
+        Command::Validate { file } => config_cmd::validate(&file),
+        Command::Config { action } => config_cmd::run(&action),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            eprintln!("bearingd: error: {}", error.message);
+            ExitCode::from(error.code)
+        }
+    }
 }

@@ -177,8 +177,8 @@ pub struct ThresholdConfig {
 impl Default for ThresholdConfig {
     fn default() -> Self {
         ThresholdConfig {
-            watch_score: 15.0,
-            alarm_score: 30.0,
+            watch_score: 10.0,
+            alarm_score: 15.0,
             clear_ratio: 0.8,
             on_delay_s: 5.0,
             off_delay_s: 30.0,

@@ -969,7 +969,7 @@ impl Checker {
             &raw.min_fault_score,
             d.min_fault_score,
             Limits::above_to(0.0, f64::INFINITY),
-            "give the smallest fault score that makes a diagnosis, e.g. min_fault_score = 30.0",
+            "give the smallest fault score that makes a diagnosis, e.g. min_fault_score = 15.0",
         );
         let min_score_ratio = self.number(
             "analysis.min_score_ratio",
@@ -1183,7 +1183,7 @@ impl Checker {
             "give the fault score at which a flag rises to watch, e.g. watch_score = 15.0",
         );
         let alarm_fix = "give the fault score at which a flag rises to alarm, above \
-                         watch_score, e.g. alarm_score = 30.0";
+                         watch_score, e.g. alarm_score = 15.0";
         let alarm_score = self.number(
             "thresholds.alarm_score",
             &raw.alarm_score,

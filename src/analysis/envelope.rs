@@ -1,0 +1,470 @@
+//! Squared-envelope spectrum (MODELS.md §2): FFT band-pass, analytic signal, squared envelope,
+//! Hann window, FFT, Welch averaging.
+//!
+//! Why it is built from two pieces: the real FFT of a window ([`WindowTransform`]) is shared by
+//! every band analysed on that window, and the per-band work ([`BandEnvelope`]) runs on a
+//! short, decimated buffer: the band's bins are moved to baseband and inverse-transformed at
+//! the smallest length that keeps the envelope spectrum alias-free up to the highest frequency
+//! asked for. The same two pieces serve the batch form ([`welch_envelope_spectrum`], used by
+//! `analyze`) and the rolling form ([`RollingEnvelope`], used by the daemon), so both compute
+//! every window the same way. All buffers are allocated at construction; nothing allocates per window.
+
+use super::band::Band;
+use realfft::{RealFftPlanner, RealToComplex};
+use rustfft::num_complex::Complex32;
+use rustfft::{Fft, FftPlanner};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// Cached FFT plans and Hann windows. Planning is slow (twiddle factors, cosines); one
+/// `FftPlans` kept for the life of an analyser shares them among every transform of a size.
+pub struct FftPlans {
+    complex: FftPlanner<f32>,
+    real: RealFftPlanner<f32>,
+    hann: HashMap<usize, Arc<[f32]>>,
+}
+
+impl Default for FftPlans {
+    fn default() -> Self {
+        FftPlans {
+            complex: FftPlanner::new(),
+            real: RealFftPlanner::new(),
+            hann: HashMap::new(),
+        }
+    }
+}
+
+impl FftPlans {
+    fn hann(&mut self, len: usize) -> Arc<[f32]> {
+        self.hann
+            .entry(len)
+            .or_insert_with(|| hann(len).into())
+            .clone()
+    }
+
+    fn inverse(&mut self, len: usize) -> Arc<dyn Fft<f32>> {
+        self.complex.plan_fft_inverse(len)
+    }
+
+    fn real_forward(&mut self, len: usize) -> Arc<dyn RealToComplex<f32>> {
+        self.real.plan_fft_forward(len)
+    }
+}
+
+/// The smallest `2^a · 3^b` not below `n`: lengths that rustfft transforms fastest.
+pub fn fast_fft_len(n: usize) -> usize {
+    let n = n.max(2);
+    let mut best = n.next_power_of_two();
+    let mut three = 1usize;
+    while three < best {
+        let candidate = three * (n.div_ceil(three)).next_power_of_two();
+        best = best.min(candidate);
+        three *= 3;
+    }
+    best
+}
+
+/// The window length, in samples, for a window of `window_s` seconds at `fs_hz`: the nearest
+/// power of two (in log scale), so that the main transform is as fast as it can be.
+pub fn window_samples(window_s: f64, fs_hz: f64) -> usize {
+    let exact = (window_s * fs_hz).max(64.0);
+    1usize << (exact.log2().round() as u32).min(30)
+}
+
+/// Periodic Hann window of length `len`.
+pub fn hann(len: usize) -> Vec<f32> {
+    (0..len)
+        .map(|i| {
+            let phase = std::f64::consts::TAU * i as f64 / len as f64;
+            (0.5 - 0.5 * phase.cos()) as f32
+        })
+        .collect()
+}
+
+/// The real FFT of one analysis window of raw samples.
+pub struct WindowTransform {
+    fft: Arc<dyn RealToComplex<f32>>,
+    input: Vec<f32>,
+    spectrum: Vec<Complex32>,
+    scratch: Vec<Complex32>,
+}
+
+impl WindowTransform {
+    pub fn new(window: usize, plans: &mut FftPlans) -> Self {
+        let fft = plans.real_forward(window);
+        WindowTransform {
+            input: fft.make_input_vec(),
+            spectrum: fft.make_output_vec(),
+            scratch: fft.make_scratch_vec(),
+            fft,
+        }
+    }
+
+    pub fn window(&self) -> usize {
+        self.input.len()
+    }
+
+    /// Transforms the window formed by `older` followed by `newer` (the two halves of a ring
+    /// buffer, or one slice and an empty one); their lengths must add up to the window.
+    pub fn transform(&mut self, older: &[f32], newer: &[f32]) -> &[Complex32] {
+        debug_assert_eq!(older.len() + newer.len(), self.input.len());
+        self.input[..older.len()].copy_from_slice(older);
+        self.input[older.len()..].copy_from_slice(newer);
+        // Lengths match by construction, so the transform cannot fail.
+        let _ =
+            self.fft
+                .process_with_scratch(&mut self.input, &mut self.spectrum, &mut self.scratch);
+        &self.spectrum
+    }
+
+    pub fn spectrum(&self) -> &[Complex32] {
+        &self.spectrum
+    }
+}
+
+/// Band-pass, analytic signal and squared-envelope spectrum of one band, on the spectrum of
+/// a window computed by [`WindowTransform`].
+pub struct BandEnvelope {
+    band: Band,
+    first_bin: usize,
+    bin_count: usize,
+    /// `2 / window`: scales the band's bins so that `|analytic|` is the signal's amplitude.
+    bin_scale: f32,
+    inverse: Arc<dyn Fft<f32>>,
+    analytic: Vec<Complex32>,
+    inverse_scratch: Vec<Complex32>,
+    envelope_fft: Arc<dyn RealToComplex<f32>>,
+    envelope: Vec<f32>,
+    envelope_spectrum: Vec<Complex32>,
+    envelope_scratch: Vec<Complex32>,
+    hann: Arc<[f32]>,
+    /// `(2 / Σ hann)²`: turns `|FFT|²` into the squared amplitude of each envelope component.
+    power_scale: f32,
+    spectrum_bins: usize,
+}
+
+impl BandEnvelope {
+    /// `spectrum_bins`: how many envelope-spectrum bins (spaced `fs_hz / window`) to produce,
+    /// from 0 Hz up.
+    pub fn new(
+        band: Band,
+        fs_hz: f64,
+        window: usize,
+        spectrum_bins: usize,
+        plans: &mut FftPlans,
+    ) -> Self {
+        let (first_bin, last_bin) = band.bins(fs_hz, window);
+        let bin_count = last_bin - first_bin;
+        // The squared envelope of a band of B bins reaches B bins; at a length L its spectrum
+        // folds at L - B, so L >= B + spectrum_bins keeps [0, spectrum_bins) alias-free.
+        let len = fast_fft_len((bin_count + spectrum_bins).max(2 * spectrum_bins));
+        let inverse = plans.inverse(len);
+        let envelope_fft = plans.real_forward(len);
+        let hann = plans.hann(len);
+        let hann_sum: f32 = hann.iter().sum();
+        BandEnvelope {
+            band,
+            first_bin,
+            bin_count,
+            bin_scale: 2.0 / window as f32,
+            inverse_scratch: vec![Complex32::default(); inverse.get_inplace_scratch_len()],
+            inverse,
+            analytic: vec![Complex32::default(); len],
+            envelope: envelope_fft.make_input_vec(),
+            envelope_spectrum: envelope_fft.make_output_vec(),
+            envelope_scratch: envelope_fft.make_scratch_vec(),
+            envelope_fft,
+            hann,
+            power_scale: (2.0 / hann_sum).powi(2),
+            spectrum_bins,
+        }
+    }
+
+    pub fn band(&self) -> Band {
+        self.band
+    }
+
+    /// Length of the decimated analytic signal of one window.
+    pub fn analytic_len(&self) -> usize {
+        self.analytic.len()
+    }
+
+    pub fn spectrum_bins(&self) -> usize {
+        self.spectrum_bins
+    }
+
+    /// The band's analytic signal over the window, shifted to baseband and decimated: its
+    /// magnitude is the envelope.
+    pub fn analytic_from(&mut self, window_spectrum: &[Complex32]) -> &[Complex32] {
+        let source = &window_spectrum[self.first_bin..self.first_bin + self.bin_count];
+        for (dst, src) in self.analytic.iter_mut().zip(source) {
+            *dst = src * self.bin_scale;
+        }
+        self.analytic[self.bin_count..].fill(Complex32::default());
+        self.inverse
+            .process_with_scratch(&mut self.analytic, &mut self.inverse_scratch);
+        &self.analytic
+    }
+
+    /// The squared-envelope power spectrum of the analytic signal last computed by
+    /// [`Self::analytic_from`], written into `out` (`spectrum_bins` values, squared amplitude
+    /// in g⁴ of each envelope component).
+    pub fn squared_envelope_power(&mut self, out: &mut [f32]) {
+        let len = self.envelope.len() as f32;
+        let mean = self.analytic.iter().map(|c| c.norm_sqr()).sum::<f32>() / len;
+        for ((e, c), w) in self
+            .envelope
+            .iter_mut()
+            .zip(&self.analytic)
+            .zip(self.hann.iter())
+        {
+            *e = (c.norm_sqr() - mean) * w;
+        }
+        let _ = self.envelope_fft.process_with_scratch(
+            &mut self.envelope,
+            &mut self.envelope_spectrum,
+            &mut self.envelope_scratch,
+        );
+        for (o, s) in out.iter_mut().zip(&self.envelope_spectrum) {
+            *o = s.norm_sqr() * self.power_scale;
+        }
+    }
+
+    /// Both steps at once: the squared-envelope power spectrum of this band on a window.
+    pub fn process(&mut self, window_spectrum: &[Complex32], out: &mut [f32]) {
+        self.analytic_from(window_spectrum);
+        self.squared_envelope_power(out);
+    }
+}
+
+/// Start indices of the Welch windows over a record of `len` samples.
+pub fn window_starts(len: usize, window: usize, hop: usize) -> impl Iterator<Item = usize> {
+    let count = if len >= window {
+        (len - window) / hop.max(1) + 1
+    } else {
+        0
+    };
+    (0..count).map(move |i| i * hop.max(1))
+}
+
+/// Hop length for a window and an overlap fraction.
+pub fn hop_samples(window: usize, overlap: f64) -> usize {
+    ((window as f64 * (1.0 - overlap)).round() as usize).clamp(1, window)
+}
+
+/// A Welch-averaged envelope spectrum: amplitude (square root of the mean power) per bin.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnvelopeSpectrum {
+    pub band: Band,
+    /// Bin spacing in Hz (`fs / window`).
+    pub bin_hz: f64,
+    /// Amplitude of each envelope component, in g², from 0 Hz up.
+    pub amplitude: Vec<f32>,
+    pub windows_averaged: usize,
+}
+
+impl EnvelopeSpectrum {
+    pub fn frequencies(&self) -> impl Iterator<Item = f64> + '_ {
+        (0..self.amplitude.len()).map(|k| k as f64 * self.bin_hz)
+    }
+}
+
+/// Turns a sum of power spectra into the averaged amplitude.
+pub fn averaged_amplitude(power_sum: &[f64], count: usize) -> Vec<f32> {
+    let count = count.max(1) as f64;
+    power_sum
+        .iter()
+        .map(|p| (p / count).sqrt() as f32)
+        .collect()
+}
+
+/// Batch form: the Welch-averaged squared-envelope spectrum of a whole record in one band.
+pub fn welch_envelope_spectrum(
+    plans: &mut FftPlans,
+    signal: &[f32],
+    fs_hz: f64,
+    band: Band,
+    window: usize,
+    overlap: f64,
+    spectrum_bins: usize,
+) -> EnvelopeSpectrum {
+    let mut transform = WindowTransform::new(window, plans);
+    let mut envelope = BandEnvelope::new(band, fs_hz, window, spectrum_bins, plans);
+    let mut power = vec![0f32; spectrum_bins];
+    let mut sum = vec![0f64; spectrum_bins];
+    let mut count = 0;
+    for start in window_starts(signal.len(), window, hop_samples(window, overlap)) {
+        let spectrum = transform.transform(&signal[start..start + window], &[]);
+        envelope.process(spectrum, &mut power);
+        for (s, p) in sum.iter_mut().zip(&power) {
+            *s += f64::from(*p);
+        }
+        count += 1;
+    }
+    EnvelopeSpectrum {
+        band,
+        bin_hz: fs_hz / window as f64,
+        amplitude: averaged_amplitude(&sum, count),
+        windows_averaged: count,
+    }
+}
+
+/// One update of the rolling envelope spectrum, handed to the caller every hop.
+pub struct EnvelopeUpdate<'a> {
+    /// Sample index (in the channel's sample time) one past the last sample of the window.
+    pub end_sample: u64,
+    pub band: Band,
+    pub bin_hz: f64,
+    /// The newest window's power spectrum.
+    pub latest_power: &'a [f32],
+    /// The average over the last `windows_averaged` windows, as amplitude.
+    pub averaged_amplitude: &'a [f32],
+    pub windows_averaged: usize,
+    /// The raw samples of the newest window, oldest first, as two slices of the ring buffer.
+    pub window_samples: (&'a [f32], &'a [f32]),
+}
+
+/// Rolling form: a ring buffer of the last window of samples; every hop, the envelope
+/// spectrum of the newest window and the average of the last `averages` windows.
+///
+/// All memory is allocated in [`RollingEnvelope::new`] and [`RollingEnvelope::set_band`];
+/// [`RollingEnvelope::push`] never allocates (tested with a counting allocator).
+pub struct RollingEnvelope {
+    fs_hz: f64,
+    hop: usize,
+    ring: Vec<f32>,
+    /// Index in `ring` where the next sample goes; also where the oldest sample is once full.
+    write_at: usize,
+    filled: usize,
+    until_update: usize,
+    samples_seen: u64,
+    transform: WindowTransform,
+    band: BandEnvelope,
+    plans: FftPlans,
+    latest: Vec<f32>,
+    history: Vec<f32>,
+    history_used: usize,
+    history_next: usize,
+    averaged: Vec<f32>,
+}
+
+impl RollingEnvelope {
+    pub fn new(
+        fs_hz: f64,
+        window: usize,
+        hop: usize,
+        averages: usize,
+        band: Band,
+        spectrum_bins: usize,
+    ) -> Self {
+        let mut plans = FftPlans::default();
+        let transform = WindowTransform::new(window, &mut plans);
+        let band = BandEnvelope::new(band, fs_hz, window, spectrum_bins, &mut plans);
+        let averages = averages.max(1);
+        RollingEnvelope {
+            fs_hz,
+            hop: hop.clamp(1, window),
+            ring: vec![0.0; window],
+            write_at: 0,
+            filled: 0,
+            until_update: window,
+            samples_seen: 0,
+            transform,
+            band,
+            plans,
+            latest: vec![0.0; spectrum_bins],
+            history: vec![0.0; averages * spectrum_bins],
+            history_used: 0,
+            history_next: 0,
+            averaged: vec![0.0; spectrum_bins],
+        }
+    }
+
+    pub fn band(&self) -> Band {
+        self.band.band()
+    }
+
+    pub fn window(&self) -> usize {
+        self.ring.len()
+    }
+
+    pub fn samples_seen(&self) -> u64 {
+        self.samples_seen
+    }
+
+    /// Switches to another band (allocates; meant for the periodic band re-selection, not
+    /// per hop). The average restarts, since spectra of different bands do not mix.
+    pub fn set_band(&mut self, band: Band) {
+        let bins = self.latest.len();
+        self.band = BandEnvelope::new(band, self.fs_hz, self.ring.len(), bins, &mut self.plans);
+        self.history_used = 0;
+        self.history_next = 0;
+    }
+
+    /// Forgets the buffered samples (after a gap in the signal: a window must never straddle
+    /// a gap) and restarts the average. `next_sample` is the sample index of the next sample.
+    pub fn restart_at(&mut self, next_sample: u64) {
+        self.filled = 0;
+        self.write_at = 0;
+        self.until_update = self.ring.len();
+        self.samples_seen = next_sample;
+        self.history_used = 0;
+        self.history_next = 0;
+    }
+
+    /// Feeds samples; calls `on_update` once per completed hop.
+    pub fn push(&mut self, mut samples: &[f32], mut on_update: impl FnMut(&EnvelopeUpdate)) {
+        let window = self.ring.len();
+        while !samples.is_empty() {
+            let take = samples
+                .len()
+                .min(self.until_update)
+                .min(window - self.write_at);
+            self.ring[self.write_at..self.write_at + take].copy_from_slice(&samples[..take]);
+            samples = &samples[take..];
+            self.write_at = (self.write_at + take) % window;
+            self.filled = (self.filled + take).min(window);
+            self.until_update -= take;
+            self.samples_seen += take as u64;
+            if self.until_update == 0 {
+                self.until_update = self.hop;
+                self.update(&mut on_update);
+            }
+        }
+    }
+
+    fn update(&mut self, on_update: &mut impl FnMut(&EnvelopeUpdate)) {
+        let (newer, older) = self.ring.split_at(self.write_at);
+        let spectrum = self.transform.transform(older, newer);
+        self.band.process(spectrum, &mut self.latest);
+
+        let bins = self.latest.len();
+        let slots = self.history.len() / bins;
+        let slot = self.history_next * bins;
+        self.history[slot..slot + bins].copy_from_slice(&self.latest);
+        self.history_next = (self.history_next + 1) % slots;
+        self.history_used = (self.history_used + 1).min(slots);
+        // Recomputed from the history each hop (not a running sum) so that rounding never drifts
+        // over months of operation.
+        self.averaged.fill(0.0);
+        for past in self.history.chunks_exact(bins).take(self.history_used) {
+            for (a, p) in self.averaged.iter_mut().zip(past) {
+                *a += p;
+            }
+        }
+        let scale = 1.0 / self.history_used as f32;
+        for a in &mut self.averaged {
+            *a = (*a * scale).sqrt();
+        }
+        let (newer, older) = self.ring.split_at(self.write_at);
+        on_update(&EnvelopeUpdate {
+            end_sample: self.samples_seen,
+            band: self.band.band(),
+            bin_hz: self.fs_hz / self.ring.len() as f64,
+            latest_power: &self.latest,
+            averaged_amplitude: &self.averaged,
+            windows_averaged: self.history_used,
+            window_samples: (older, newer),
+        });
+    }
+}

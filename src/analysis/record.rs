@@ -1,0 +1,277 @@
+//! Whole-record analysis, as `bearingd analyze` runs it: indicators, the band scan, band
+//! selection, per-hypothesis band refinement, fault scores and the verdict.
+
+use super::band::Band;
+use super::diagnosis::{diagnose, Diagnosis};
+use super::envelope::{window_samples, EnvelopeSpectrum, FftPlans};
+use super::fault_bands::{FaultKind, FaultScore, FaultScorer};
+use super::indicators::Indicators;
+use super::kurtogram::{band_tree, scan_bands, BandScan, TreeLevel};
+use super::settings::{AnalysisSettings, BandSelection};
+use crate::bearing::FaultFrequencies;
+
+/// Why a record could not be analysed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AnalysisError {
+    #[error("the record has {samples} samples ({seconds:.3} s) but one analysis window needs {window} ({window_s:.3} s at {fs_hz} Hz); give a longer record or a shorter window")]
+    TooShort {
+        samples: usize,
+        seconds: f64,
+        window: usize,
+        window_s: f64,
+        fs_hz: f64,
+    },
+    #[error("sample rate {0} Hz is not usable; give the rate in Hz, e.g. --fs 12000")]
+    BadSampleRate(f64),
+    #[error("shaft speed {0} Hz is not usable; give the speed, e.g. --rpm 1797")]
+    BadSpeed(f64),
+    #[error("{what} at {freq_hz:.1} Hz lies above the Nyquist frequency {nyquist:.0} Hz of this record; check --fs and --rpm")]
+    AboveNyquist {
+        what: String,
+        freq_hz: f64,
+        nyquist: f64,
+    },
+}
+
+/// The band chosen for one fault hypothesis and the score it gives.
+#[derive(Debug, Clone)]
+pub struct Hypothesis {
+    pub score: FaultScore,
+    /// Index into [`RecordAnalysis::scan`]`.bands`.
+    pub band_index: usize,
+}
+
+/// Everything `analyze` reports about one record.
+#[derive(Debug, Clone)]
+pub struct RecordAnalysis {
+    pub fs_hz: f64,
+    pub samples: usize,
+    pub window: usize,
+    pub frequencies: FaultFrequencies,
+    pub indicators: Indicators,
+    pub scan: BandScan,
+    /// The band the selection method (kurtogram, GK or fixed) chose.
+    pub selected_band_index: usize,
+    pub hypotheses: Vec<Hypothesis>,
+    pub diagnosis: Diagnosis,
+    /// The band behind the verdict: the diagnosed fault's band, else the selected band.
+    pub reported_band_index: usize,
+}
+
+impl RecordAnalysis {
+    pub fn duration_s(&self) -> f64 {
+        self.samples as f64 / self.fs_hz
+    }
+
+    pub fn band(&self) -> Band {
+        self.scan.bands[self.reported_band_index].band
+    }
+
+    pub fn spectrum(&self) -> &EnvelopeSpectrum {
+        &self.scan.bands[self.reported_band_index].spectrum
+    }
+
+    pub fn selected_band(&self) -> Band {
+        self.scan.bands[self.selected_band_index].band
+    }
+
+    pub fn score(&self, kind: FaultKind) -> f64 {
+        self.hypotheses
+            .iter()
+            .find(|h| h.score.fault == kind)
+            .map_or(0.0, |h| h.score.score)
+    }
+}
+
+/// The highest envelope frequency the scores need: the last harmonic of the highest fault
+/// frequency, its upper sideband, and the noise neighbourhood beyond it.
+pub fn envelope_range_hz(freqs: &FaultFrequencies, harmonics: usize) -> f64 {
+    let top = freqs.bpfo.max(freqs.bpfi).max(freqs.two_bsf);
+    (harmonics as f64 + 0.5) * top + freqs.shaft
+}
+
+/// Analyses whole records; keeps FFT plans between records so that only the first pays for
+/// planning.
+#[derive(Default)]
+pub struct RecordAnalyzer {
+    plans: FftPlans,
+}
+
+/// Analyses one record with a fresh [`RecordAnalyzer`].
+pub fn analyze_record(
+    signal: &[f32],
+    fs_hz: f64,
+    freqs: &FaultFrequencies,
+    settings: &AnalysisSettings,
+) -> Result<RecordAnalysis, AnalysisError> {
+    RecordAnalyzer::default().analyze(signal, fs_hz, freqs, settings)
+}
+
+impl RecordAnalyzer {
+    /// Analyses a whole record of acceleration samples at `fs_hz`.
+    pub fn analyze(
+        &mut self,
+        signal: &[f32],
+        fs_hz: f64,
+        freqs: &FaultFrequencies,
+        settings: &AnalysisSettings,
+    ) -> Result<RecordAnalysis, AnalysisError> {
+        if !(fs_hz.is_finite() && fs_hz > 0.0) {
+            return Err(AnalysisError::BadSampleRate(fs_hz));
+        }
+        if !(freqs.shaft.is_finite() && freqs.shaft > 0.0) {
+            return Err(AnalysisError::BadSpeed(freqs.shaft));
+        }
+        let window = record_window(signal.len(), fs_hz, freqs, settings);
+        if signal.len() < window {
+            return Err(AnalysisError::TooShort {
+                samples: signal.len(),
+                seconds: signal.len() as f64 / fs_hz,
+                window,
+                window_s: window as f64 / fs_hz,
+                fs_hz,
+            });
+        }
+        let nyquist = fs_hz / 2.0;
+        let range_hz = envelope_range_hz(freqs, settings.harmonics);
+        if range_hz >= nyquist {
+            return Err(AnalysisError::AboveNyquist {
+                what: "the highest fault harmonic".into(),
+                freq_hz: range_hz,
+                nyquist,
+            });
+        }
+        let bin_hz = fs_hz / window as f64;
+        let spectrum_bins = ((range_hz / bin_hz).ceil() as usize + 1).min(window / 2);
+
+        let tree = match settings.band_selection {
+            BandSelection::Fixed { lo_hz, hi_hz } => {
+                if hi_hz > nyquist {
+                    return Err(AnalysisError::AboveNyquist {
+                        what: "the fixed band's upper edge".into(),
+                        freq_hz: hi_hz,
+                        nyquist,
+                    });
+                }
+                vec![TreeLevel {
+                    level: 0.0,
+                    bands: vec![Band::new(lo_hz, hi_hz)],
+                }]
+            }
+            _ => {
+                let top = freqs.bpfo.max(freqs.bpfi).max(freqs.two_bsf);
+                band_tree(fs_hz, settings.min_band_hz.unwrap_or(3.0 * top))
+            }
+        };
+        let with_gini = matches!(settings.band_selection, BandSelection::GiniKurtosis);
+        let scan = scan_bands(
+            &mut self.plans,
+            signal,
+            fs_hz,
+            window,
+            settings.overlap,
+            &tree,
+            spectrum_bins,
+            with_gini,
+        );
+        let selected_band_index = match settings.band_selection {
+            BandSelection::Fixed { .. } => 0,
+            BandSelection::Kurtogram => best_index(&scan, false),
+            BandSelection::GiniKurtosis => best_index(&scan, true),
+        };
+
+        let mut scorer =
+            FaultScorer::new(settings.fault_tolerance, settings.harmonics, spectrum_bins);
+        let refine = settings.refine_band_by_snr
+            && !matches!(settings.band_selection, BandSelection::Fixed { .. });
+        let hypotheses: Vec<Hypothesis> = FaultKind::ALL
+            .iter()
+            .map(|&kind| {
+                let candidates: Vec<usize> = if refine {
+                    (0..scan.bands.len()).collect()
+                } else {
+                    vec![selected_band_index]
+                };
+                candidates
+                    .into_iter()
+                    .map(|i| {
+                        let spectrum = &scan.bands[i].spectrum;
+                        Hypothesis {
+                            score: scorer.score(&spectrum.amplitude, spectrum.bin_hz, kind, freqs),
+                            band_index: i,
+                        }
+                    })
+                    .max_by(|a, b| a.score.score.total_cmp(&b.score.score))
+                    .unwrap_or(Hypothesis {
+                        score: scorer.score(&[], bin_hz, kind, freqs),
+                        band_index: selected_band_index,
+                    })
+            })
+            .collect();
+        let scores: Vec<FaultScore> = hypotheses.iter().map(|h| h.score).collect();
+        let diagnosis = diagnose(&scores, settings.min_fault_score, settings.min_score_ratio);
+        let reported_band_index = diagnosis
+            .verdict
+            .fault()
+            .and_then(|kind| hypotheses.iter().find(|h| h.score.fault == kind))
+            .map_or(selected_band_index, |h| h.band_index);
+
+        Ok(RecordAnalysis {
+            fs_hz,
+            samples: signal.len(),
+            window,
+            frequencies: *freqs,
+            indicators: Indicators::of(signal),
+            scan,
+            selected_band_index,
+            hypotheses,
+            diagnosis,
+            reported_band_index,
+        })
+    }
+}
+
+/// Windows a record should hold at least for a stable Welch average.
+const MIN_WINDOWS: usize = 6;
+
+/// (choice) The configured window, halved while a short record would give fewer than
+/// [`MIN_WINDOWS`] windows and the frequency bin stays narrower than the slip tolerance of the
+/// lowest fault frequency: a 1 s IMS snapshot is then averaged over 4 windows rather than
+/// refused or left as one noisy window.
+fn record_window(
+    len: usize,
+    fs_hz: f64,
+    freqs: &FaultFrequencies,
+    settings: &AnalysisSettings,
+) -> usize {
+    let hop_fraction = (1.0 - settings.overlap).max(0.05);
+    let windows = |w: usize| {
+        if len >= w {
+            ((len - w) as f64 / (w as f64 * hop_fraction)) as usize + 1
+        } else {
+            0
+        }
+    };
+    let narrowest_bin_hz = settings.fault_tolerance * freqs.bpfo.min(freqs.bpfi).min(freqs.two_bsf);
+    let mut window = window_samples(settings.window_s, fs_hz);
+    while windows(window) < MIN_WINDOWS
+        && window > 256
+        && fs_hz / (window / 2) as f64 <= narrowest_bin_hz
+    {
+        window /= 2;
+    }
+    window
+}
+
+fn best_index(scan: &BandScan, use_gk: bool) -> usize {
+    let key = |i: &usize| {
+        if use_gk {
+            scan.bands[*i].gk
+        } else {
+            scan.bands[*i].kurtosis
+        }
+    };
+    (0..scan.bands.len())
+        .max_by(|a, b| key(a).total_cmp(&key(b)))
+        .unwrap_or(0)
+}

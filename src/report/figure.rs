@@ -1,0 +1,140 @@
+//! The picture of an analysis: the envelope spectrum with the fault frequencies and their
+//! harmonics marked (tolerance shaded), and the kurtogram with the band that was used.
+
+use super::AnalyzeReport;
+use crate::analysis::{BandSelection, FaultKind, RecordAnalysis};
+use crate::plot::{Color, Figure, HeatmapPanel, HeatmapRow, Marker, Series, Shade, SpectrumPanel};
+
+fn fault_color(kind: FaultKind) -> Color {
+    match kind {
+        FaultKind::OuterRace => Color::VERMILLION,
+        FaultKind::InnerRace => Color::BLUE,
+        FaultKind::Ball => Color::BLUISH_GREEN,
+        FaultKind::Cage => Color::REDDISH_PURPLE,
+    }
+}
+
+/// The figure of `bearingd analyze --plot`.
+pub fn analysis_figure(report: &AnalyzeReport, analysis: &RecordAnalysis) -> Figure {
+    let spectrum = analysis.spectrum();
+    let x: Vec<f64> = spectrum.frequencies().collect();
+    let x_max = x.last().copied().unwrap_or(0.0);
+    let mut panel = SpectrumPanel::new(
+        "envelope frequency (Hz)",
+        "squared-envelope amplitude (g²)",
+        x,
+    );
+    panel.series.push(Series {
+        label: format!(
+            "measured, band {:.0}–{:.0} Hz",
+            report.band_hz[0], report.band_hz[1]
+        ),
+        y: spectrum.amplitude.iter().map(|&v| f64::from(v)).collect(),
+        color: Color::BLACK,
+    });
+    panel.log_y = true;
+    panel.x_range = Some((0.0, x_max));
+    let tolerance = report.thresholds.fault_tolerance;
+    let diagnosed = analysis.diagnosis.verdict.fault();
+    for kind in [FaultKind::OuterRace, FaultKind::InnerRace, FaultKind::Ball] {
+        let f = kind.frequency(&analysis.frequencies);
+        let color = fault_color(kind);
+        for order in 1..=report.thresholds.harmonics {
+            let at = order as f64 * f;
+            if at > x_max {
+                break;
+            }
+            let label = if order == 1 {
+                kind.frequency_label().to_string()
+            } else {
+                format!("{} x{order}", kind.frequency_label())
+            };
+            panel.markers.push(Marker {
+                x: at,
+                label,
+                color,
+                dashed: diagnosed != Some(kind),
+            });
+            panel.shaded.push(Shade {
+                x0: at * (1.0 - tolerance),
+                x1: at * (1.0 + tolerance),
+                color: color.with_alpha(40),
+            });
+        }
+    }
+    let shaft = analysis.frequencies.shaft;
+    panel.markers.push(Marker {
+        x: shaft,
+        label: "1x shaft".into(),
+        color: Color::GREY,
+        dashed: true,
+    });
+
+    let use_gk = matches!(report_selection(report), Some(BandSelection::GiniKurtosis));
+    let mut rows = Vec::new();
+    let mut highlight = None;
+    for (row, level) in analysis.scan.levels.iter().enumerate() {
+        let bands: Vec<(usize, _)> = analysis
+            .scan
+            .bands
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.level == *level)
+            .collect();
+        for (cell, (index, _)) in bands.iter().enumerate() {
+            if *index == analysis.reported_band_index {
+                highlight = Some((row, cell));
+            }
+        }
+        rows.push(HeatmapRow {
+            label: format!("{level}"),
+            values: bands
+                .iter()
+                .map(|(_, b)| if use_gk { b.gk } else { b.kurtosis })
+                .collect(),
+        });
+    }
+    let heatmap = HeatmapPanel {
+        title: format!(
+            "{} per band of the kurtogram tree (level per row)",
+            if use_gk {
+                "GK index"
+            } else {
+                "spectral kurtosis"
+            }
+        ),
+        x_label: "frequency (Hz)".into(),
+        x_max: analysis.fs_hz / 2.0,
+        rows,
+        highlight,
+        value_label: if use_gk {
+            "GK index".into()
+        } else {
+            "kurtosis".into()
+        },
+    };
+
+    Figure::new(format!("{} [{}]", report.file, report.channel))
+        .with_note(format!(
+            "diagnosis: {} (confidence {:.2}) - {}",
+            report.diagnosis, report.confidence, report.reason
+        ))
+        .with_note(format!(
+            "{:.0} rpm, bearing {}, band {:.0}-{:.0} Hz: {}",
+            report.rpm,
+            report.bearing,
+            report.band_hz[0],
+            report.band_hz[1],
+            report.band_selection.reason
+        ))
+        .with_panel(panel)
+        .with_panel(heatmap)
+}
+
+fn report_selection(report: &AnalyzeReport) -> Option<BandSelection> {
+    match report.band_selection.method {
+        "gk" => Some(BandSelection::GiniKurtosis),
+        "kurtogram" => Some(BandSelection::Kurtogram),
+        _ => None,
+    }
+}

@@ -1,0 +1,207 @@
+//! What `analyze` tells its user about a record: a JSON document for programs, a text summary
+//! for people, and a figure for the eyes. One [`AnalyzeReport`] feeds all three so that they
+//! always say the same thing.
+
+mod figure;
+mod text;
+
+pub use figure::analysis_figure;
+pub use text::render_text;
+
+use crate::analysis::fault_bands::HarmonicPeak;
+use crate::analysis::indicators::Indicators;
+use crate::analysis::{BandSelection, FaultKind, RecordAnalysis};
+use crate::bearing::BearingGeometry;
+use serde::Serialize;
+
+/// Where the shaft speed came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpeedSource {
+    /// The recording states it (e.g. CWRU's `XNNNRPM` variable).
+    File,
+    /// `--rpm` on the command line (or the config).
+    Given,
+    /// The data set's documented constant speed (e.g. IMS: 2000 rpm).
+    DataSetDefault,
+    /// The simulated record's speed.
+    Simulation,
+}
+
+/// The record's identity and operating conditions, as the caller resolved them.
+#[derive(Debug, Clone)]
+pub struct RecordContext {
+    pub file: String,
+    pub channel: String,
+    pub rpm: f64,
+    pub rpm_source: SpeedSource,
+    pub bearing: BearingGeometry,
+    /// Why this bearing, if it was not given (e.g. "default for CWRU drive-end records").
+    pub bearing_note: Option<String>,
+    pub selection: BandSelection,
+    pub warnings: Vec<String>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct FaultFrequenciesHz {
+    pub shaft: f64,
+    pub bpfo: f64,
+    pub bpfi: f64,
+    pub bsf: f64,
+    pub two_bsf: f64,
+    pub ftf: f64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Scores {
+    pub outer_race: f64,
+    pub inner_race: f64,
+    pub ball: f64,
+    pub cage: f64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct BandSelectionReport {
+    /// `kurtogram`, `gk` or `fixed`.
+    pub method: &'static str,
+    /// The band the method chose.
+    pub selected_hz: [f64; 2],
+    /// Why the reported band is the one it is.
+    pub reason: String,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct HypothesisReport {
+    pub fault: FaultKind,
+    pub frequency_hz: f64,
+    pub band_hz: [f64; 2],
+    pub score: f64,
+    pub sideband_score: Option<f64>,
+    pub harmonics: Vec<HarmonicPeak>,
+}
+
+/// The JSON document of `bearingd analyze --format json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct AnalyzeReport {
+    pub file: String,
+    pub channel: String,
+    pub fs_hz: f64,
+    pub rpm: f64,
+    pub rpm_source: SpeedSource,
+    pub bearing: String,
+    pub bearing_geometry: BearingGeometry,
+    pub duration_s: f64,
+    pub samples: usize,
+    pub window_samples: usize,
+    pub windows_averaged: usize,
+    pub band_hz: [f64; 2],
+    pub band_selection: BandSelectionReport,
+    pub fault_frequencies_hz: FaultFrequenciesHz,
+    pub scores: Scores,
+    pub diagnosis: &'static str,
+    pub confidence: f64,
+    pub reason: String,
+    pub thresholds: Thresholds,
+    pub indicators: Indicators,
+    pub hypotheses: Vec<HypothesisReport>,
+    pub warnings: Vec<String>,
+}
+
+/// The decision thresholds the verdict was reached with.
+#[derive(Debug, Clone, Serialize)]
+pub struct Thresholds {
+    pub min_fault_score: f64,
+    pub min_score_ratio: f64,
+    pub fault_tolerance: f64,
+    pub harmonics: usize,
+}
+
+fn band_pair(band: crate::analysis::Band) -> [f64; 2] {
+    [band.lo_hz, band.hi_hz]
+}
+
+impl AnalyzeReport {
+    pub fn new(
+        context: &RecordContext,
+        analysis: &RecordAnalysis,
+        settings: &crate::analysis::AnalysisSettings,
+    ) -> Self {
+        let f = &analysis.frequencies;
+        let method = match context.selection {
+            BandSelection::Kurtogram => "kurtogram",
+            BandSelection::GiniKurtosis => "gk",
+            BandSelection::Fixed { .. } => "fixed",
+        };
+        let method_words = match context.selection {
+            BandSelection::Kurtogram => "the fast kurtogram",
+            BandSelection::GiniKurtosis => "the GK index",
+            BandSelection::Fixed { .. } => "the configuration (fixed band)",
+        };
+        let reason = match analysis.diagnosis.verdict.fault() {
+            Some(kind) if analysis.reported_band_index != analysis.selected_band_index => format!(
+                "{} shows {} best (fault-band SNR refinement); {} chose {}",
+                analysis.band(),
+                kind.frequency_label(),
+                method_words,
+                analysis.selected_band()
+            ),
+            _ => format!("chosen by {method_words}"),
+        };
+        AnalyzeReport {
+            file: context.file.clone(),
+            channel: context.channel.clone(),
+            fs_hz: analysis.fs_hz,
+            rpm: context.rpm,
+            rpm_source: context.rpm_source,
+            bearing: context.bearing.name.clone(),
+            bearing_geometry: context.bearing.clone(),
+            duration_s: analysis.duration_s(),
+            samples: analysis.samples,
+            window_samples: analysis.window,
+            windows_averaged: analysis.spectrum().windows_averaged,
+            band_hz: band_pair(analysis.band()),
+            band_selection: BandSelectionReport {
+                method,
+                selected_hz: band_pair(analysis.selected_band()),
+                reason,
+            },
+            fault_frequencies_hz: FaultFrequenciesHz {
+                shaft: f.shaft,
+                bpfo: f.bpfo,
+                bpfi: f.bpfi,
+                bsf: f.bsf,
+                two_bsf: f.two_bsf,
+                ftf: f.ftf,
+            },
+            scores: Scores {
+                outer_race: analysis.score(FaultKind::OuterRace),
+                inner_race: analysis.score(FaultKind::InnerRace),
+                ball: analysis.score(FaultKind::Ball),
+                cage: analysis.score(FaultKind::Cage),
+            },
+            diagnosis: analysis.diagnosis.verdict.name(),
+            confidence: analysis.diagnosis.confidence,
+            reason: analysis.diagnosis.reason.clone(),
+            thresholds: Thresholds {
+                min_fault_score: settings.min_fault_score,
+                min_score_ratio: settings.min_score_ratio,
+                fault_tolerance: settings.fault_tolerance,
+                harmonics: settings.harmonics,
+            },
+            indicators: analysis.indicators,
+            hypotheses: analysis
+                .hypotheses
+                .iter()
+                .map(|h| HypothesisReport {
+                    fault: h.score.fault,
+                    frequency_hz: h.score.frequency_hz,
+                    band_hz: band_pair(analysis.scan.bands[h.band_index].band),
+                    score: h.score.score,
+                    sideband_score: h.score.sideband_score,
+                    harmonics: h.score.peaks().to_vec(),
+                })
+                .collect(),
+            warnings: context.warnings.clone(),
+        }
+    }
+}

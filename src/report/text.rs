@@ -1,0 +1,82 @@
+//! The text summary of `bearingd analyze`: what a maintenance engineer reads first.
+
+use super::{AnalyzeReport, SpeedSource};
+use std::fmt::Write;
+
+/// Renders the report as a few aligned lines of text.
+pub fn render_text(r: &AnalyzeReport) -> String {
+    let mut out = String::new();
+    let speed_from = match r.rpm_source {
+        SpeedSource::File => "from the file",
+        SpeedSource::Given => "given",
+        SpeedSource::DataSetDefault => "the data set's constant speed",
+        SpeedSource::Simulation => "simulated",
+    };
+    let g = &r.bearing_geometry;
+    let _ = writeln!(out, "{}  [{}]", r.file, r.channel);
+    let _ = writeln!(
+        out,
+        "  {:.0} Hz, {:.2} s, {:.1} rpm ({speed_from}); bearing {} (z={}, d={} mm, D={} mm, α={}°)",
+        r.fs_hz,
+        r.duration_s,
+        r.rpm,
+        r.bearing,
+        g.rolling_elements,
+        g.element_diameter_mm,
+        g.pitch_diameter_mm,
+        g.contact_angle_deg
+    );
+    let f = &r.fault_frequencies_hz;
+    let _ = writeln!(
+        out,
+        "  fault frequencies: BPFO {:.1} Hz, BPFI {:.1} Hz, 2xBSF {:.1} Hz, FTF {:.2} Hz, shaft {:.2} Hz",
+        f.bpfo, f.bpfi, f.two_bsf, f.ftf, f.shaft
+    );
+    let _ = writeln!(
+        out,
+        "  band {:.0}–{:.0} Hz: {}; {} windows of {} samples",
+        r.band_hz[0], r.band_hz[1], r.band_selection.reason, r.windows_averaged, r.window_samples
+    );
+    let _ = writeln!(
+        out,
+        "  fault scores (peak/median over {} harmonics, ±{:.0} %; a fault needs ≥ {:.0} and {:.1}× the runner-up):",
+        r.thresholds.harmonics,
+        r.thresholds.fault_tolerance * 100.0,
+        r.thresholds.min_fault_score,
+        r.thresholds.min_score_ratio
+    );
+    for h in &r.hypotheses {
+        let bar_len = (h.score.max(1.0).log2() * 4.0).round().clamp(0.0, 40.0) as usize;
+        let sidebands = h
+            .sideband_score
+            .map(|s| format!("  sidebands {s:.1}"))
+            .unwrap_or_default();
+        let _ = writeln!(
+            out,
+            "    {:<11} {:>7.1}  {:<40} in {:.0}–{:.0} Hz{}",
+            h.fault.name(),
+            h.score,
+            "#".repeat(bar_len),
+            h.band_hz[0],
+            h.band_hz[1],
+            sidebands
+        );
+    }
+    let i = &r.indicators;
+    let _ = writeln!(
+        out,
+        "  indicators: RMS {:.4} g, peak {:.3} g, crest {:.2}, kurtosis {:.2}",
+        i.rms, i.peak, i.crest, i.kurtosis
+    );
+    for w in &r.warnings {
+        let _ = writeln!(out, "  warning: {w}");
+    }
+    let _ = writeln!(
+        out,
+        "  diagnosis: {} (confidence {:.2}): {}",
+        r.diagnosis.to_uppercase(),
+        r.confidence,
+        r.reason
+    );
+    out
+}
