@@ -10,6 +10,7 @@
 //!   every problem reported at once.
 //! - [`recording`]: readers for recorded data (CWRU `.mat`, PRONOSTIA and plain CSV, IMS text,
 //!   WAV) that turn a file into samples plus what the file says about itself.
+//! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
 //! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
 //! - [`twin`]: the signal-model twin of a defective bearing (simulation now, fitting later).
@@ -21,6 +22,7 @@ pub mod analysis;
 pub mod bearing;
 pub mod cli;
 pub mod config;
+pub mod offline;
 pub mod plot;
 pub mod recording;
 pub mod report;

@@ -36,8 +36,6 @@ pub struct RecordContext {
     pub rpm: f64,
     pub rpm_source: SpeedSource,
     pub bearing: BearingGeometry,
-    /// Why this bearing, if it was not given (e.g. "default for CWRU drive-end records").
-    pub bearing_note: Option<String>,
     pub selection: BandSelection,
     pub warnings: Vec<String>,
 }

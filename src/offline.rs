@@ -1,0 +1,154 @@
+//! Offline analysis of one recording: `bearingd analyze` as a library call.
+//!
+//! Resolves what the analysis needs and the file may not state (sample rate, shaft speed,
+//! bearing) from, in order: the caller's overrides, the file itself, and the data set's own
+//! documentation (IMS runs at 2000 rpm on Rexnord ZA-2115 bearings, CWRU's drive end is an
+//! SKF 6205-2RS). Every assumption is written into the report's warnings; what cannot be
+//! resolved is an error that says which option gives it.
+
+use crate::analysis::record::RecordAnalyzer;
+use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
+use crate::bearing::{BearingError, BearingGeometry};
+use crate::recording::{read_recording, ReadOptions, Recording, RecordingError, RecordingFormat};
+use crate::report::{AnalyzeReport, RecordContext, SpeedSource};
+use crate::twin::{SimulatedFault, SimulationParams, Simulator};
+use std::path::PathBuf;
+
+/// What to analyse and how.
+#[derive(Debug, Clone, Default)]
+pub struct AnalyzeRequest {
+    /// The recording; `None` analyses the built-in simulated record.
+    pub file: Option<PathBuf>,
+    pub read: ReadOptions,
+    pub fs_hz: Option<f64>,
+    pub rpm: Option<f64>,
+    /// A catalog name or custom geometry; `None`: the data set's bearing, if known.
+    pub bearing: Option<String>,
+    pub settings: AnalysisSettings,
+}
+
+/// Why a recording could not be analysed. Each message names the file and the fix.
+#[derive(Debug, thiserror::Error)]
+pub enum OfflineError {
+    #[error(transparent)]
+    Recording(#[from] RecordingError),
+    #[error("{file}: {source}")]
+    Analysis { file: String, source: AnalysisError },
+    #[error(transparent)]
+    Bearing(#[from] BearingError),
+    #[error("{file}: the sample rate is unknown ({format} files do not state it); give it with --fs, e.g. --fs 12000")]
+    UnknownSampleRate { file: String, format: RecordingFormat },
+    #[error("{file}: the shaft speed is unknown (the file does not state it); give it with --rpm, e.g. --rpm 1797")]
+    UnknownSpeed { file: String },
+    #[error("{file}: which bearing is it? give --bearing with a catalog name ({known}) or custom geometry \"z=8,d=5.97mm,D=31.62mm,alpha=0\"")]
+    UnknownBearing { file: String, known: String },
+    #[error("{what} {value} is not usable; {fix}")]
+    BadOverride { what: &'static str, value: f64, fix: &'static str },
+}
+
+/// The outcome: the full analysis and the report made from it.
+pub struct AnalyzeOutcome {
+    pub analysis: RecordAnalysis,
+    pub report: AnalyzeReport,
+}
+
+/// What a data set's documentation says when the file itself does not.
+#[derive(Default)]
+struct DataSetFacts {
+    rpm: Option<f64>,
+    bearing: Option<(&'static str, &'static str)>,
+}
+
+fn data_set_facts(recording: &Recording) -> DataSetFacts {
+    match recording.format {
+        RecordingFormat::CwruMat if recording.channel.contains("_FE_") => {
+            DataSetFacts { rpm: None, bearing: Some(("skf-6203-2rs", "the CWRU fan-end bearing")) }
+        }
+        RecordingFormat::CwruMat => DataSetFacts { rpm: None, bearing: Some(("skf-6205-2rs", "the CWRU drive-end bearing")) },
+        RecordingFormat::PronostiaCsv => DataSetFacts { rpm: None, bearing: Some(("pronostia", "the PRONOSTIA test bearing")) },
+        RecordingFormat::ImsText => {
+            DataSetFacts { rpm: Some(2000.0), bearing: Some(("rexnord-za-2115", "the IMS test rig's bearing")) }
+        }
+        RecordingFormat::PlainCsv | RecordingFormat::Wav => DataSetFacts::default(),
+    }
+}
+
+/// Ten seconds of the twin's outer-race fault: needs no data and no hardware.
+pub fn demo_recording() -> Recording {
+    let params = SimulationParams::example(SimulatedFault::OuterRace);
+    let samples = Simulator::record(params.clone(), 10.0).into_iter().map(f64::from).collect();
+    Recording {
+        path: PathBuf::from(format!("demo:outer_race(seed {})", params.seed)),
+        format: RecordingFormat::Wav,
+        channel: "simulated".into(),
+        fs_hz: Some(params.fs_hz),
+        rpm: Some(params.rpm),
+        samples,
+        warnings: vec![format!(
+            "simulated record: outer-race fault on {}, resonance {:.0} Hz, noise {} g, seed {}",
+            params.bearing.name, params.resonance_hz, params.noise_g, params.seed
+        )],
+    }
+}
+
+/// Reads (or simulates) the record, resolves its conditions, analyses it.
+pub fn analyze(request: &AnalyzeRequest, analyzer: &mut RecordAnalyzer) -> Result<AnalyzeOutcome, OfflineError> {
+    let (recording, facts, simulated) = match &request.file {
+        Some(path) => {
+            let recording = read_recording(path, &request.read)?;
+            let facts = data_set_facts(&recording);
+            (recording, facts, false)
+        }
+        None => (demo_recording(), DataSetFacts { rpm: None, bearing: Some(("skf-6205-2rs", "the simulated bearing")) }, true),
+    };
+    let file = recording.path.display().to_string();
+    let fs_hz = match request.fs_hz {
+        Some(fs) if !(fs.is_finite() && fs > 0.0) => {
+            return Err(OfflineError::BadOverride { what: "--fs", value: fs, fix: "give the sample rate in Hz, e.g. --fs 12000" })
+        }
+        Some(fs) => fs,
+        None => recording.fs_hz.ok_or_else(|| OfflineError::UnknownSampleRate { file: file.clone(), format: recording.format })?,
+    };
+    let (rpm, rpm_source) = match (request.rpm, recording.rpm, facts.rpm) {
+        (Some(rpm), _, _) if !(rpm.is_finite() && rpm > 0.0) => {
+            return Err(OfflineError::BadOverride { what: "--rpm", value: rpm, fix: "give the shaft speed in rpm, e.g. --rpm 1797" })
+        }
+        (Some(rpm), _, _) => (rpm, SpeedSource::Given),
+        (None, Some(rpm), _) => (rpm, if simulated { SpeedSource::Simulation } else { SpeedSource::File }),
+        (None, None, Some(rpm)) => (rpm, SpeedSource::DataSetDefault),
+        (None, None, None) => return Err(OfflineError::UnknownSpeed { file }),
+    };
+    let mut warnings = recording.warnings.clone();
+    let bearing = match (&request.bearing, facts.bearing) {
+        (Some(text), _) => BearingGeometry::parse(text)?,
+        (None, Some((name, why))) => {
+            let bearing = BearingGeometry::from_catalog(name)?;
+            if !simulated {
+                warnings.push(format!("bearing not given: assumed {name} ({why}); give --bearing to change"));
+            }
+            bearing
+        }
+        (None, None) => {
+            return Err(OfflineError::UnknownBearing { file, known: BearingGeometry::catalog_names().join(", ") });
+        }
+    };
+    if rpm_source == SpeedSource::DataSetDefault {
+        warnings.push(format!("speed not in the file: assumed the data set's constant {rpm} rpm; give --rpm to change"));
+    }
+    let freqs = bearing.fault_frequencies(rpm / 60.0);
+    let samples: Vec<f32> = recording.samples.iter().map(|&x| x as f32).collect();
+    let analysis = analyzer
+        .analyze(&samples, fs_hz, &freqs, &request.settings)
+        .map_err(|source| OfflineError::Analysis { file: file.clone(), source })?;
+    let context = RecordContext {
+        file,
+        channel: recording.channel.clone(),
+        rpm,
+        rpm_source,
+        bearing,
+        selection: request.settings.band_selection,
+        warnings,
+    };
+    let report = AnalyzeReport::new(&context, &analysis, &request.settings);
+    Ok(AnalyzeOutcome { analysis, report })
+}
