@@ -1,1 +1,99 @@
-fn main() {}
+//! Speed of the analysis core (issue 2 targets, reported in docs/PERFORMANCE.md):
+//! - `analyze` of a 10 s, 12 kHz record: ≤ 10 ms on one core;
+//! - one rolling envelope-spectrum update with a 16384-sample window: ≤ 150 µs.
+//!
+//! Run: `cargo bench --bench analysis`. The record is CWRU 105 when ../shared/data is there,
+//! else 10 s of the twin's simulated outer-race fault (the same size).
+
+use bearingd::analysis::envelope::RollingEnvelope;
+use bearingd::analysis::record::{analyze_record, RecordAnalyzer};
+use bearingd::analysis::{AnalysisSettings, Band, BandSelection};
+use bearingd::bearing::BearingGeometry;
+use bearingd::recording::{read_recording, ReadOptions};
+use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
+use criterion::{criterion_group, criterion_main, Criterion};
+use std::hint::black_box;
+use std::path::Path;
+
+fn ten_second_record() -> (Vec<f32>, f64, f64, &'static str) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/cwru/12k_Drive_End_IR007_0_105.mat");
+    match read_recording(&path, &ReadOptions::default()) {
+        Ok(r) => (
+            r.samples.iter().map(|&x| x as f32).collect(),
+            12_000.0,
+            r.rpm.unwrap_or(1797.0),
+            "CWRU 105",
+        ),
+        Err(_) => {
+            let params = SimulationParams::example(SimulatedFault::OuterRace);
+            (
+                Simulator::record(params.clone(), 10.0),
+                params.fs_hz,
+                params.rpm,
+                "simulated",
+            )
+        }
+    }
+}
+
+fn analyze(c: &mut Criterion) {
+    let (signal, fs, rpm, name) = ten_second_record();
+    let freqs = BearingGeometry::from_catalog("skf-6205-2rs")
+        .unwrap()
+        .fault_frequencies(rpm / 60.0);
+    let mut group = c.benchmark_group(format!("analyze 10 s at 12 kHz ({name})"));
+    for (label, selection) in [
+        ("gk", BandSelection::GiniKurtosis),
+        ("kurtogram", BandSelection::Kurtogram),
+    ] {
+        let settings = AnalysisSettings {
+            band_selection: selection,
+            ..AnalysisSettings::default()
+        };
+        let mut analyzer = RecordAnalyzer::default();
+        group.bench_function(format!("{label}, plans reused"), |b| {
+            b.iter(|| {
+                analyzer
+                    .analyze(black_box(&signal), fs, &freqs, &settings)
+                    .unwrap()
+            })
+        });
+    }
+    let settings = AnalysisSettings::default();
+    group.bench_function("gk, first call (plans made)", |b| {
+        b.iter(|| analyze_record(black_box(&signal), fs, &freqs, &settings).unwrap())
+    });
+    group.finish();
+}
+
+fn rolling_update(c: &mut Criterion) {
+    let fs = 25_600.0;
+    let (window, hop) = (16_384, 4_096);
+    let bins = 1_200;
+    let params = SimulationParams {
+        fs_hz: fs,
+        ..SimulationParams::example(SimulatedFault::OuterRace)
+    };
+    let signal = Simulator::record(params, 4.0);
+    let mut rolling = RollingEnvelope::new(fs, window, hop, 8, Band::new(2_000.0, 6_000.0), bins);
+    rolling.push(&signal[..window], |_| {});
+    let mut at = window;
+    c.bench_function(
+        "rolling update, 16384-sample window, 2-6 kHz band, 8 averages",
+        |b| {
+            b.iter(|| {
+                if at + hop > signal.len() {
+                    at = window;
+                }
+                let mut peak = 0f32;
+                rolling.push(&signal[at..at + hop], |u| peak = u.averaged_amplitude[100]);
+                at += hop;
+                black_box(peak)
+            })
+        },
+    );
+}
+
+criterion_group!(benches, analyze, rolling_update);
+criterion_main!(benches);

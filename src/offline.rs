@@ -37,13 +37,20 @@ pub enum OfflineError {
     #[error(transparent)]
     Bearing(#[from] BearingError),
     #[error("{file}: the sample rate is unknown ({format} files do not state it); give it with --fs, e.g. --fs 12000")]
-    UnknownSampleRate { file: String, format: RecordingFormat },
+    UnknownSampleRate {
+        file: String,
+        format: RecordingFormat,
+    },
     #[error("{file}: the shaft speed is unknown (the file does not state it); give it with --rpm, e.g. --rpm 1797")]
     UnknownSpeed { file: String },
     #[error("{file}: which bearing is it? give --bearing with a catalog name ({known}) or custom geometry \"z=8,d=5.97mm,D=31.62mm,alpha=0\"")]
     UnknownBearing { file: String, known: String },
     #[error("{what} {value} is not usable; {fix}")]
-    BadOverride { what: &'static str, value: f64, fix: &'static str },
+    BadOverride {
+        what: &'static str,
+        value: f64,
+        fix: &'static str,
+    },
 }
 
 /// The outcome: the full analysis and the report made from it.
@@ -61,14 +68,22 @@ struct DataSetFacts {
 
 fn data_set_facts(recording: &Recording) -> DataSetFacts {
     match recording.format {
-        RecordingFormat::CwruMat if recording.channel.contains("_FE_") => {
-            DataSetFacts { rpm: None, bearing: Some(("skf-6203-2rs", "the CWRU fan-end bearing")) }
-        }
-        RecordingFormat::CwruMat => DataSetFacts { rpm: None, bearing: Some(("skf-6205-2rs", "the CWRU drive-end bearing")) },
-        RecordingFormat::PronostiaCsv => DataSetFacts { rpm: None, bearing: Some(("pronostia", "the PRONOSTIA test bearing")) },
-        RecordingFormat::ImsText => {
-            DataSetFacts { rpm: Some(2000.0), bearing: Some(("rexnord-za-2115", "the IMS test rig's bearing")) }
-        }
+        RecordingFormat::CwruMat if recording.channel.contains("_FE_") => DataSetFacts {
+            rpm: None,
+            bearing: Some(("skf-6203-2rs", "the CWRU fan-end bearing")),
+        },
+        RecordingFormat::CwruMat => DataSetFacts {
+            rpm: None,
+            bearing: Some(("skf-6205-2rs", "the CWRU drive-end bearing")),
+        },
+        RecordingFormat::PronostiaCsv => DataSetFacts {
+            rpm: None,
+            bearing: Some(("pronostia", "the PRONOSTIA test bearing")),
+        },
+        RecordingFormat::ImsText => DataSetFacts {
+            rpm: Some(2000.0),
+            bearing: Some(("rexnord-za-2115", "the IMS test rig's bearing")),
+        },
         RecordingFormat::PlainCsv | RecordingFormat::Wav => DataSetFacts::default(),
     }
 }
@@ -76,7 +91,10 @@ fn data_set_facts(recording: &Recording) -> DataSetFacts {
 /// Ten seconds of the twin's outer-race fault: needs no data and no hardware.
 pub fn demo_recording() -> Recording {
     let params = SimulationParams::example(SimulatedFault::OuterRace);
-    let samples = Simulator::record(params.clone(), 10.0).into_iter().map(f64::from).collect();
+    let samples = Simulator::record(params.clone(), 10.0)
+        .into_iter()
+        .map(f64::from)
+        .collect();
     Recording {
         path: PathBuf::from(format!("demo:outer_race(seed {})", params.seed)),
         format: RecordingFormat::Wav,
@@ -92,29 +110,59 @@ pub fn demo_recording() -> Recording {
 }
 
 /// Reads (or simulates) the record, resolves its conditions, analyses it.
-pub fn analyze(request: &AnalyzeRequest, analyzer: &mut RecordAnalyzer) -> Result<AnalyzeOutcome, OfflineError> {
+pub fn analyze(
+    request: &AnalyzeRequest,
+    analyzer: &mut RecordAnalyzer,
+) -> Result<AnalyzeOutcome, OfflineError> {
     let (recording, facts, simulated) = match &request.file {
         Some(path) => {
             let recording = read_recording(path, &request.read)?;
             let facts = data_set_facts(&recording);
             (recording, facts, false)
         }
-        None => (demo_recording(), DataSetFacts { rpm: None, bearing: Some(("skf-6205-2rs", "the simulated bearing")) }, true),
+        None => (
+            demo_recording(),
+            DataSetFacts {
+                rpm: None,
+                bearing: Some(("skf-6205-2rs", "the simulated bearing")),
+            },
+            true,
+        ),
     };
     let file = recording.path.display().to_string();
     let fs_hz = match request.fs_hz {
         Some(fs) if !(fs.is_finite() && fs > 0.0) => {
-            return Err(OfflineError::BadOverride { what: "--fs", value: fs, fix: "give the sample rate in Hz, e.g. --fs 12000" })
+            return Err(OfflineError::BadOverride {
+                what: "--fs",
+                value: fs,
+                fix: "give the sample rate in Hz, e.g. --fs 12000",
+            })
         }
         Some(fs) => fs,
-        None => recording.fs_hz.ok_or_else(|| OfflineError::UnknownSampleRate { file: file.clone(), format: recording.format })?,
+        None => recording
+            .fs_hz
+            .ok_or_else(|| OfflineError::UnknownSampleRate {
+                file: file.clone(),
+                format: recording.format,
+            })?,
     };
     let (rpm, rpm_source) = match (request.rpm, recording.rpm, facts.rpm) {
         (Some(rpm), _, _) if !(rpm.is_finite() && rpm > 0.0) => {
-            return Err(OfflineError::BadOverride { what: "--rpm", value: rpm, fix: "give the shaft speed in rpm, e.g. --rpm 1797" })
+            return Err(OfflineError::BadOverride {
+                what: "--rpm",
+                value: rpm,
+                fix: "give the shaft speed in rpm, e.g. --rpm 1797",
+            })
         }
         (Some(rpm), _, _) => (rpm, SpeedSource::Given),
-        (None, Some(rpm), _) => (rpm, if simulated { SpeedSource::Simulation } else { SpeedSource::File }),
+        (None, Some(rpm), _) => (
+            rpm,
+            if simulated {
+                SpeedSource::Simulation
+            } else {
+                SpeedSource::File
+            },
+        ),
         (None, None, Some(rpm)) => (rpm, SpeedSource::DataSetDefault),
         (None, None, None) => return Err(OfflineError::UnknownSpeed { file }),
     };
@@ -124,12 +172,17 @@ pub fn analyze(request: &AnalyzeRequest, analyzer: &mut RecordAnalyzer) -> Resul
         (None, Some((name, why))) => {
             let bearing = BearingGeometry::from_catalog(name)?;
             if !simulated {
-                warnings.push(format!("bearing not given: assumed {name} ({why}); give --bearing to change"));
+                warnings.push(format!(
+                    "bearing not given: assumed {name} ({why}); give --bearing to change"
+                ));
             }
             bearing
         }
         (None, None) => {
-            return Err(OfflineError::UnknownBearing { file, known: BearingGeometry::catalog_names().join(", ") });
+            return Err(OfflineError::UnknownBearing {
+                file,
+                known: BearingGeometry::catalog_names().join(", "),
+            });
         }
     };
     if rpm_source == SpeedSource::DataSetDefault {
@@ -139,7 +192,10 @@ pub fn analyze(request: &AnalyzeRequest, analyzer: &mut RecordAnalyzer) -> Resul
     let samples: Vec<f32> = recording.samples.iter().map(|&x| x as f32).collect();
     let analysis = analyzer
         .analyze(&samples, fs_hz, &freqs, &request.settings)
-        .map_err(|source| OfflineError::Analysis { file: file.clone(), source })?;
+        .map_err(|source| OfflineError::Analysis {
+            file: file.clone(),
+            source,
+        })?;
     let context = RecordContext {
         file,
         channel: recording.channel.clone(),

@@ -12,21 +12,8 @@ fn channel(name: &str) -> ReadOptions {
     }
 }
 
-/// Rows of a small manifest CSV as (header → value) lookups.
 fn manifest(dir: &Path) -> Vec<std::collections::HashMap<String, String>> {
-    let text = std::fs::read_to_string(dir.join("manifest.csv")).expect("manifest.csv");
-    let mut lines = text.lines();
-    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
-    lines
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| {
-            header
-                .iter()
-                .cloned()
-                .zip(l.split(',').map(String::from))
-                .collect()
-        })
-        .collect()
+    bearingd::recording::testdata::read_manifest(dir)
 }
 
 #[test]

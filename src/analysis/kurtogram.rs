@@ -19,8 +19,8 @@
 
 use super::band::Band;
 use super::envelope::{
-    averaged_amplitude, hop_samples, window_starts, BandEnvelope, EnvelopeSpectrum, FftPlans,
-    WindowTransform,
+    averaged_amplitude, hop_samples, power_moments, window_starts, BandEnvelope, EnvelopeSpectrum,
+    FftPlans, WindowTransform,
 };
 use serde::Serialize;
 
@@ -122,12 +122,7 @@ impl EnvelopeMoments {
 
     /// Adds the squared envelope of a run of analytic-signal samples.
     fn add(&mut self, analytic: &[rustfft::num_complex::Complex32]) {
-        let (mut sum2, mut sum4) = (0f32, 0f32);
-        for c in analytic {
-            let e = c.norm_sqr();
-            sum2 += e;
-            sum4 += e * e;
-        }
+        let (sum2, sum4) = power_moments(analytic);
         self.count += analytic.len() as u64;
         self.sum2 += f64::from(sum2);
         self.sum4 += f64::from(sum4);

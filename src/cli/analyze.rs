@@ -76,7 +76,11 @@ pub struct AnalyzeArgs {
 
 pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
     let settings = settings_from(args)?;
-    let files: Vec<Option<PathBuf>> = if args.demo { vec![None] } else { args.files.iter().cloned().map(Some).collect() };
+    let files: Vec<Option<PathBuf>> = if args.demo {
+        vec![None]
+    } else {
+        args.files.iter().cloned().map(Some).collect()
+    };
     let mut analyzer = RecordAnalyzer::default();
     let mut reports = Vec::new();
     let mut failures = Vec::new();
@@ -86,7 +90,10 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
     for file in &files {
         let request = AnalyzeRequest {
             file: file.clone(),
-            read: ReadOptions { channel: args.channel.clone(), column: args.column.clone() },
+            read: ReadOptions {
+                channel: args.channel.clone(),
+                column: args.column.clone(),
+            },
             fs_hz: args.fs,
             rpm: args.rpm,
             bearing: args.bearing.clone(),
@@ -102,8 +109,13 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
             Err(error) => return Err(CliError::input(error)),
         };
         if let Some(plot) = &args.plot {
-            let path = if files.len() > 1 { per_record_path(plot, &outcome.report.file) } else { plot.clone() };
-            crate::plot::save(&analysis_figure(&outcome.report, &outcome.analysis), &path).map_err(CliError::input)?;
+            let path = if files.len() > 1 {
+                per_record_path(plot, &outcome.report.file)
+            } else {
+                plot.clone()
+            };
+            crate::plot::save(&analysis_figure(&outcome.report, &outcome.analysis), &path)
+                .map_err(CliError::input)?;
         }
         match args.format {
             OutputFormat::Text => print!("{}", render_text(&outcome.report)),
@@ -113,12 +125,19 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
         reports.push(outcome.report);
     }
     if args.format == OutputFormat::Json {
-        let json = if reports.len() == 1 { serde_json::to_string_pretty(&reports[0]) } else { serde_json::to_string_pretty(&reports) };
+        let json = if reports.len() == 1 {
+            serde_json::to_string_pretty(&reports[0])
+        } else {
+            serde_json::to_string_pretty(&reports)
+        };
         println!("{}", json.map_err(CliError::failure)?);
     }
     match failures.len() {
         0 => Ok(()),
-        n => Err(CliError::input(format!("{n} of {} recordings could not be analysed (see above)", files.len()))),
+        n => Err(CliError::input(format!(
+            "{n} of {} recordings could not be analysed (see above)",
+            files.len()
+        ))),
     }
 }
 
@@ -127,7 +146,9 @@ fn table_header() -> String {
 }
 
 fn table_row(r: &AnalyzeReport) -> String {
-    let name = Path::new(&r.file).file_name().map_or(r.file.clone(), |n| n.to_string_lossy().into_owned());
+    let name = Path::new(&r.file)
+        .file_name()
+        .map_or(r.file.clone(), |n| n.to_string_lossy().into_owned());
     format!(
         "| {name} | {} | {:.0} | {:.0}–{:.0} | {:.1} | {:.1} | {:.1} | {:.1} | {} | {:.2} |",
         r.channel,
@@ -145,9 +166,18 @@ fn table_row(r: &AnalyzeReport) -> String {
 
 /// `out.png` + `dir/105.mat` → `out-105.png`.
 fn per_record_path(plot: &Path, record: &str) -> PathBuf {
-    let stem = plot.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let ext = plot.extension().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
-    let record = Path::new(record).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    let stem = plot
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = plot
+        .extension()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let record = Path::new(record)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
     plot.with_file_name(format!("{stem}-{record}.{ext}"))
 }
 
@@ -158,7 +188,9 @@ fn settings_from(args: &AnalyzeArgs) -> Result<AnalysisSettings, CliError> {
     };
     if let Some(window) = args.window {
         if !(window.is_finite() && window > 0.01 && window <= 10.0) {
-            return Err(CliError::input(format!("--window {window} is not usable; give seconds in (0.01, 10], e.g. --window 1")));
+            return Err(CliError::input(format!(
+                "--window {window} is not usable; give seconds in (0.01, 10], e.g. --window 1"
+            )));
         }
         settings.window_s = window;
     }
@@ -171,15 +203,28 @@ fn settings_from(args: &AnalyzeArgs) -> Result<AnalysisSettings, CliError> {
         (Some(BandMethod::Fixed) | None, Some(text)) => {
             let parsed = text
                 .split_once('-')
-                .and_then(|(lo, hi)| Some((lo.trim().parse::<f64>().ok()?, hi.trim().parse::<f64>().ok()?)))
+                .and_then(|(lo, hi)| {
+                    Some((
+                        lo.trim().parse::<f64>().ok()?,
+                        hi.trim().parse::<f64>().ok()?,
+                    ))
+                })
                 .filter(|(lo, hi)| lo.is_finite() && hi.is_finite() && *lo >= 0.0 && lo < hi);
             let Some((lo_hz, hi_hz)) = parsed else {
                 return Err(CliError::input(format!("--band {text} is not a band; give LO-HI in Hz with LO < HI, e.g. --band 2000-4000")));
             };
             settings.band_selection = BandSelection::Fixed { lo_hz, hi_hz };
         }
-        (Some(BandMethod::Fixed), None) => return Err(CliError::input("--band-selection fixed needs --band LO-HI, e.g. --band 2000-4000")),
-        (Some(_), Some(_)) => return Err(CliError::input("--band is only for --band-selection fixed; drop one of them")),
+        (Some(BandMethod::Fixed), None) => {
+            return Err(CliError::input(
+                "--band-selection fixed needs --band LO-HI, e.g. --band 2000-4000",
+            ))
+        }
+        (Some(_), Some(_)) => {
+            return Err(CliError::input(
+                "--band is only for --band-selection fixed; drop one of them",
+            ))
+        }
         (None, None) => {}
     }
     Ok(settings)

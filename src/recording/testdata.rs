@@ -56,3 +56,30 @@ pub fn scratch_dir(test: &str) -> PathBuf {
         .unwrap_or_else(|e| panic!("cannot create scratch dir {}: {e}", dir.display()));
     dir
 }
+
+/// The rows of a data set's `manifest.csv`, each as column name → value.
+///
+/// # Panics
+/// When the manifest cannot be read (tests only).
+pub fn read_manifest(dir: &Path) -> Vec<std::collections::HashMap<String, String>> {
+    let path = dir.join("manifest.csv");
+    let text = std::fs::read_to_string(&path)
+        .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap_or_default()
+        .split(',')
+        .map(String::from)
+        .collect();
+    lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            header
+                .iter()
+                .cloned()
+                .zip(l.split(',').map(String::from))
+                .collect()
+        })
+        .collect()
+}

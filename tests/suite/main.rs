@@ -1,5 +1,7 @@
 //! The integration-test suite: one binary, one module per part (ripgrep's layout), so that the
 //! suite links once.
 
+mod cli;
+mod developer_set;
 mod envelope;
 mod kinematics;

@@ -1,0 +1,235 @@
+//! The `bearingd` binary as a user meets it: outputs, pictures, and one-line errors with exit
+//! code 2 for every kind of bad input.
+
+use bearingd::recording::testdata::{scratch_dir, shared_data_dir};
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn bearingd(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(args)
+        .output()
+        .expect("run bearingd")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// Runs `args`, expects exit code 2 and a one-line error containing every `needle`.
+fn expect_input_error(args: &[&str], needles: &[&str]) {
+    let out = bearingd(args);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert_eq!(
+        err.trim_end().lines().count(),
+        1,
+        "{args:?}: not one line: {err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    for needle in needles {
+        assert!(err.contains(needle), "{args:?}: '{err}' lacks '{needle}'");
+    }
+}
+
+#[test]
+fn demo_json_has_every_documented_key_and_finds_the_simulated_fault() {
+    let out = bearingd(&["analyze", "--demo", "--format", "json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    for key in [
+        "file",
+        "channel",
+        "fs_hz",
+        "rpm",
+        "bearing",
+        "duration_s",
+        "band_hz",
+        "fault_frequencies_hz",
+        "scores",
+        "diagnosis",
+        "confidence",
+        "indicators",
+    ] {
+        assert!(json.get(key).is_some(), "missing key {key}");
+    }
+    for key in ["bpfo", "bpfi", "bsf", "ftf"] {
+        assert!(
+            json["fault_frequencies_hz"][key].as_f64().unwrap() > 0.0,
+            "{key}"
+        );
+    }
+    for key in ["outer_race", "inner_race", "ball", "cage"] {
+        assert!(json["scores"][key].is_number(), "{key}");
+    }
+    for key in ["rms", "peak", "crest", "kurtosis"] {
+        assert!(json["indicators"][key].as_f64().unwrap() > 0.0, "{key}");
+    }
+    assert_eq!(json["band_hz"].as_array().unwrap().len(), 2);
+    assert_eq!(json["diagnosis"], "outer_race");
+}
+
+#[test]
+fn plots_are_written_as_png_and_svg() {
+    let dir = scratch_dir("cli-plot");
+    let png = dir.join("demo.png");
+    let svg = dir.join("demo.svg");
+    for path in [&png, &svg] {
+        let out = bearingd(&["analyze", "--demo", "--plot", path.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("<svg") && text.contains("BPFO") && text.contains("GK index"));
+    expect_input_error(
+        &[
+            "analyze",
+            "--demo",
+            "--plot",
+            dir.join("demo.gif").to_str().unwrap(),
+        ],
+        &["demo.gif", ".png"],
+    );
+}
+
+#[test]
+fn bad_recordings_give_one_line_errors_naming_the_file() {
+    let dir = scratch_dir("cli-bad");
+    let p = |name: &str| dir.join(name).to_string_lossy().into_owned();
+
+    std::fs::write(
+        dir.join("notes.mat"),
+        "this is a text file, not MATLAB\n".repeat(10),
+    )
+    .unwrap();
+    expect_input_error(
+        &["analyze", &p("notes.mat")],
+        &["notes.mat", "not a MATLAB"],
+    );
+
+    let nan: String = (0..20_000)
+        .map(|i| {
+            if i == 1234 {
+                "NaN\n".to_string()
+            } else {
+                format!("{}\n", (i % 7) as f64 * 0.1)
+            }
+        })
+        .collect();
+    std::fs::write(dir.join("nan.csv"), nan).unwrap();
+    expect_input_error(
+        &[
+            "analyze",
+            &p("nan.csv"),
+            "--fs",
+            "12000",
+            "--rpm",
+            "1797",
+            "--bearing",
+            "skf-6205-2rs",
+        ],
+        &["nan.csv", "1234"],
+    );
+
+    let short: String = (0..500).map(|i| format!("{}\n", (i % 5) as f64)).collect();
+    std::fs::write(dir.join("short.csv"), short).unwrap();
+    expect_input_error(
+        &[
+            "analyze",
+            &p("short.csv"),
+            "--fs",
+            "12000",
+            "--rpm",
+            "1797",
+            "--bearing",
+            "skf-6205-2rs",
+        ],
+        &["short.csv", "500 samples"],
+    );
+
+    expect_input_error(
+        &[
+            "analyze",
+            &p("short.csv"),
+            "--rpm",
+            "1797",
+            "--bearing",
+            "skf-6205-2rs",
+        ],
+        &["short.csv", "--fs"],
+    );
+    expect_input_error(
+        &[
+            "analyze",
+            &p("short.csv"),
+            "--fs",
+            "12000",
+            "--bearing",
+            "skf-6205-2rs",
+        ],
+        &["short.csv", "--rpm"],
+    );
+    expect_input_error(
+        &["analyze", &p("short.csv"), "--fs", "12000", "--rpm", "1797"],
+        &["short.csv", "--bearing"],
+    );
+    expect_input_error(
+        &["analyze", &p("missing.mat")],
+        &["missing.mat", "not found"],
+    );
+    expect_input_error(
+        &["analyze", "--demo", "--bearing", "z=9,d=7.94mm"],
+        &["D (pitch diameter) is missing"],
+    );
+
+    let Some(cwru) = shared_data_dir("cwru") else {
+        return;
+    };
+    let real = cwru.join("12k_Drive_End_IR007_0_105.mat");
+    let bytes = std::fs::read(&real).unwrap();
+    std::fs::write(dir.join("cut.mat"), &bytes[..bytes.len() / 3]).unwrap();
+    expect_input_error(&["analyze", &p("cut.mat")], &["cut.mat", "truncated"]);
+    expect_input_error(
+        &[
+            "analyze",
+            real.to_str().unwrap(),
+            "--channel",
+            "X999_DE_time",
+        ],
+        &["105", "X999_DE_time", "X105_DE_time"],
+    );
+}
+
+#[test]
+fn validate_lists_every_problem_and_config_default_is_valid() {
+    let out = bearingd(&["config", "default"]);
+    assert!(out.status.success());
+    let committed =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("config/bearingd.toml"))
+            .unwrap();
+    assert_eq!(String::from_utf8_lossy(&out.stdout), committed);
+
+    let dir = scratch_dir("cli-validate");
+    let good = dir.join("good.toml");
+    std::fs::write(&good, &committed).unwrap();
+    let out = bearingd(&["validate", good.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", stderr(&out));
+
+    let bad = dir.join("bad.toml");
+    let text = committed
+        .replace("sample_rate_hz = 25600", "sample_rate_hz = 0")
+        .replace("overlap = 0.5", "overlap = 2.0")
+        .replace("harmonics = 3", "harmonics = 0");
+    std::fs::write(&bad, text).unwrap();
+    let out = bearingd(&["validate", bad.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    for key in [
+        "sensors[0].sample_rate_hz",
+        "analysis.overlap",
+        "analysis.harmonics",
+    ] {
+        assert!(err.contains(key), "'{err}' lacks {key}");
+    }
+}
