@@ -7,10 +7,13 @@
 //! resolved is an error that says which option gives it.
 
 use crate::analysis::record::RecordAnalyzer;
+use crate::analysis::FaultKind;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
 use crate::bearing::{BearingError, BearingGeometry};
 use crate::recording::{read_recording, ReadOptions, Recording, RecordingError, RecordingFormat};
-use crate::report::{AnalyzeReport, RecordContext, SpeedSource};
+use crate::report::{AnalyzeReport, RecordContext, SpeedSource, TwinReport};
+use crate::twin::diagnose::{combine, fit_record, TwinDiagnosis};
+use crate::twin::fit::{TwinFitter, HYPOTHESES};
 use crate::twin::{SimulatedFault, SimulationParams, Simulator};
 use std::path::PathBuf;
 
@@ -25,6 +28,8 @@ pub struct AnalyzeRequest {
     /// A catalog name or custom geometry; `None`: the data set's bearing, if known.
     pub bearing: Option<String>,
     pub settings: AnalysisSettings,
+    /// Also fit the signal-model twin for every fault hypothesis.
+    pub twin: bool,
 }
 
 /// Why a recording could not be analysed. Each message names the file and the fix.
@@ -57,6 +62,7 @@ pub enum OfflineError {
 pub struct AnalyzeOutcome {
     pub analysis: RecordAnalysis,
     pub report: AnalyzeReport,
+    pub twin: Option<TwinDiagnosis>,
 }
 
 /// What a data set's documentation says when the file itself does not.
@@ -205,6 +211,39 @@ pub fn analyze(
         selection: request.settings.band_selection,
         warnings,
     };
-    let report = AnalyzeReport::new(&context, &analysis, &request.settings);
-    Ok(AnalyzeOutcome { analysis, report })
+    let mut report = AnalyzeReport::new(&context, &analysis, &request.settings);
+    let twin = request.twin.then(|| {
+        let band_of = |kind: FaultKind| {
+            analysis
+                .hypotheses
+                .iter()
+                .find(|h| h.score.fault == kind)
+                .map_or(analysis.band(), |h| analysis.scan.bands[h.band_index].band)
+        };
+        let bands = HYPOTHESES.map(band_of);
+        // Compute time is reported, not used: the clock stays outside the analysis.
+        let started = std::time::Instant::now();
+        let twin = fit_record(
+            &mut analyzer.plans,
+            &mut TwinFitter::default(),
+            &samples,
+            fs_hz,
+            &freqs,
+            &bands,
+            analysis.window,
+            request.settings.overlap,
+            None,
+        );
+        let fit_ms = started.elapsed().as_secs_f64() * 1e3;
+        let (combined, agrees, note) = combine(&analysis.diagnosis, &twin);
+        report.confidence = combined.confidence;
+        report.reason = combined.reason;
+        report.twin = Some(TwinReport::new(&twin, fit_ms, agrees, note));
+        twin
+    });
+    Ok(AnalyzeOutcome {
+        analysis,
+        report,
+        twin,
+    })
 }

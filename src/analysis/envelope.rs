@@ -490,3 +490,35 @@ impl RollingEnvelope {
         });
     }
 }
+
+/// The Welch power spectrum of the raw signal (Hann windows, `overlap`), per bin from 0 Hz:
+/// where the resonances are. Units: squared amplitude of each component, g².
+pub fn welch_power_spectrum(
+    plans: &mut FftPlans,
+    signal: &[f32],
+    window: usize,
+    overlap: f64,
+) -> Vec<f32> {
+    let mut transform = WindowTransform::new(window, plans);
+    let hann = plans.hann(window);
+    let scale = (2.0 / hann.iter().sum::<f32>()).powi(2);
+    let mut tapered = vec![0f32; window];
+    let mut sum = vec![0f64; window / 2 + 1];
+    let mut count = 0usize;
+    for start in window_starts(signal.len(), window, hop_samples(window, overlap)) {
+        for ((t, x), w) in tapered
+            .iter_mut()
+            .zip(&signal[start..start + window])
+            .zip(hann.iter())
+        {
+            *t = x * w;
+        }
+        for (s, c) in sum.iter_mut().zip(transform.transform(&tapered, &[])) {
+            *s += f64::from(c.norm_sqr() * scale);
+        }
+        count += 1;
+    }
+    sum.iter()
+        .map(|s| (s / count.max(1) as f64) as f32)
+        .collect()
+}

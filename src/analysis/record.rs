@@ -94,7 +94,8 @@ pub fn envelope_range_hz(freqs: &FaultFrequencies, harmonics: usize) -> f64 {
 /// planning.
 #[derive(Default)]
 pub struct RecordAnalyzer {
-    plans: FftPlans,
+    /// Shared with whoever analyses the same records further (the twin fit).
+    pub plans: FftPlans,
 }
 
 /// Analyses one record with a fresh [`RecordAnalyzer`].

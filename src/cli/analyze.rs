@@ -72,6 +72,10 @@ pub struct AnalyzeArgs {
     /// Envelope-spectrum window length in seconds (rounded to a power of two samples).
     #[arg(long)]
     window: Option<f64>,
+    /// Also fit the signal-model twin for each fault hypothesis (adds `twin` to the JSON, the
+    /// twin's spectrum to the text and the plot).
+    #[arg(long)]
+    twin: bool,
 }
 
 pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
@@ -98,6 +102,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
             rpm: args.rpm,
             bearing: args.bearing.clone(),
             settings: settings.clone(),
+            twin: args.twin,
         };
         let outcome = match analyze(&request, &mut analyzer) {
             Ok(outcome) => outcome,
@@ -114,8 +119,11 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
             } else {
                 plot.clone()
             };
-            crate::plot::save(&analysis_figure(&outcome.report, &outcome.analysis), &path)
-                .map_err(CliError::input)?;
+            crate::plot::save(
+                &analysis_figure(&outcome.report, &outcome.analysis, outcome.twin.as_ref()),
+                &path,
+            )
+            .map_err(CliError::input)?;
         }
         match args.format {
             OutputFormat::Text => print!("{}", render_text(&outcome.report)),

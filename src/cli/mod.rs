@@ -7,6 +7,7 @@
 
 mod analyze;
 mod config_cmd;
+mod simulate;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -49,6 +50,8 @@ struct Cli {
 enum Command {
     /// Diagnose a recording (CWRU .mat, PRONOSTIA/IMS/plain CSV, WAV) or the built-in demo.
     Analyze(analyze::AnalyzeArgs),
+    /// Write a synthetic record of a bearing fault (the twin's signal model) as CSV or WAV.
+    Simulate(simulate::SimulateArgs),
     /// Check a configuration file; lists every problem with its key and how to fix it.
     Validate {
         /// The TOML file to check.
@@ -66,6 +69,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Analyze(args) => analyze::run(&args),
+        Command::Simulate(args) => simulate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
     };

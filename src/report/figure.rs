@@ -4,6 +4,7 @@
 use super::AnalyzeReport;
 use crate::analysis::{BandSelection, FaultKind, RecordAnalysis};
 use crate::plot::{Color, Figure, HeatmapPanel, HeatmapRow, Marker, Series, Shade, SpectrumPanel};
+use crate::twin::diagnose::TwinDiagnosis;
 
 fn fault_color(kind: FaultKind) -> Color {
     match kind {
@@ -15,7 +16,11 @@ fn fault_color(kind: FaultKind) -> Color {
 }
 
 /// The figure of `bearingd analyze --plot`.
-pub fn analysis_figure(report: &AnalyzeReport, analysis: &RecordAnalysis) -> Figure {
+pub fn analysis_figure(
+    report: &AnalyzeReport,
+    analysis: &RecordAnalysis,
+    twin: Option<&TwinDiagnosis>,
+) -> Figure {
     let spectrum = analysis.spectrum();
     let x: Vec<f64> = spectrum.frequencies().collect();
     let x_max = x.last().copied().unwrap_or(0.0);
@@ -114,7 +119,7 @@ pub fn analysis_figure(report: &AnalyzeReport, analysis: &RecordAnalysis) -> Fig
         },
     };
 
-    Figure::new(format!("{} [{}]", report.file, report.channel))
+    let figure = Figure::new(format!("{} [{}]", report.file, report.channel))
         .with_note(format!(
             "diagnosis: {} (confidence {:.2}) - {}",
             report.diagnosis, report.confidence, report.reason
@@ -127,8 +132,67 @@ pub fn analysis_figure(report: &AnalyzeReport, analysis: &RecordAnalysis) -> Fig
             report.band_hz[1],
             report.band_selection.reason
         ))
-        .with_panel(panel)
-        .with_panel(heatmap)
+        .with_panel(panel);
+    let figure = match twin {
+        Some(twin) => figure.with_panel(twin_panel(
+            twin,
+            analysis,
+            report.thresholds.fault_tolerance,
+        )),
+        None => figure,
+    };
+    figure.with_panel(heatmap)
+}
+
+/// The best twin's envelope spectrum over the measured one, in the twin's band and range.
+fn twin_panel(twin: &TwinDiagnosis, analysis: &RecordAnalysis, tolerance: f64) -> SpectrumPanel {
+    let fit = twin.best_fit();
+    let x: Vec<f64> = (0..twin.twin.len())
+        .map(|k| k as f64 * twin.bin_hz)
+        .collect();
+    let x_max = x.last().copied().unwrap_or(0.0);
+    let mut panel = SpectrumPanel::new("envelope frequency (Hz)", "amplitude (g²)", x);
+    panel.log_y = true;
+    panel.x_range = Some((0.0, x_max));
+    panel.series.push(Series {
+        label: format!(
+            "measured, band {:.0}–{:.0} Hz",
+            fit.band.lo_hz, fit.band.hi_hz
+        ),
+        y: twin.measured.clone(),
+        color: Color::BLACK,
+    });
+    panel.series.push(Series {
+        label: format!("twin: {} (error {:.3})", fit.fault.name(), fit.error),
+        y: twin.twin.clone(),
+        color: fault_color(fit.fault),
+    });
+    let f = fit.params.f_d;
+    let nominal = fit.fault.frequency(&analysis.frequencies);
+    for order in 1..=10 {
+        let at = order as f64 * f;
+        if at > x_max {
+            break;
+        }
+        let label = if order == 1 {
+            fit.fault.frequency_label().to_string()
+        } else {
+            format!("x{order}")
+        };
+        panel.markers.push(Marker {
+            x: at,
+            label,
+            color: fault_color(fit.fault),
+            dashed: true,
+        });
+        let nominal_at = order as f64 * nominal;
+        panel.shaded.push(Shade {
+            x0: nominal_at * (1.0 - tolerance),
+            x1: nominal_at * (1.0 + tolerance),
+            color: fault_color(fit.fault).with_alpha(30),
+        });
+    }
+    panel
 }
 
 fn report_selection(report: &AnalyzeReport) -> Option<BandSelection> {

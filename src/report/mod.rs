@@ -12,6 +12,8 @@ use crate::analysis::fault_bands::HarmonicPeak;
 use crate::analysis::indicators::Indicators;
 use crate::analysis::{BandSelection, FaultKind, RecordAnalysis};
 use crate::bearing::BearingGeometry;
+use crate::twin::diagnose::{ResidualSummary, TwinDiagnosis};
+use crate::twin::{HypothesisFit, TwinParams};
 use serde::Serialize;
 
 /// Where the shaft speed came from.
@@ -102,7 +104,61 @@ pub struct AnalyzeReport {
     pub thresholds: Thresholds,
     pub indicators: Indicators,
     pub hypotheses: Vec<HypothesisReport>,
+    /// The signal-model twin's fit (`analyze --twin`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub twin: Option<TwinReport>,
     pub warnings: Vec<String>,
+}
+
+/// The twin's errors per hypothesis.
+#[derive(Debug, Clone, Serialize)]
+pub struct TwinErrors {
+    pub outer_race: Option<f64>,
+    pub inner_race: Option<f64>,
+    pub ball: Option<f64>,
+}
+
+/// The `twin` object of the JSON report.
+#[derive(Debug, Clone, Serialize)]
+pub struct TwinReport {
+    /// The hypothesis whose twin fits best.
+    pub hypothesis: FaultKind,
+    pub params: TwinParams,
+    pub error: f64,
+    /// Error of the runner-up hypothesis minus the best error.
+    pub margin: f64,
+    pub errors: TwinErrors,
+    /// Compute time of the fits (all hypotheses), milliseconds.
+    pub fit_ms: f64,
+    pub band_hz: [f64; 2],
+    pub residual: ResidualSummary,
+    pub agrees_with_scores: bool,
+    pub note: String,
+    /// Every hypothesis's fit.
+    pub fits: Vec<HypothesisFit>,
+}
+
+impl TwinReport {
+    pub fn new(twin: &TwinDiagnosis, fit_ms: f64, agrees_with_scores: bool, note: String) -> Self {
+        let best = twin.best_fit();
+        TwinReport {
+            hypothesis: best.fault,
+            params: best.params,
+            error: best.error,
+            margin: twin.margin,
+            errors: TwinErrors {
+                outer_race: twin.error_of(FaultKind::OuterRace),
+                inner_race: twin.error_of(FaultKind::InnerRace),
+                ball: twin.error_of(FaultKind::Ball),
+            },
+            fit_ms,
+            band_hz: band_pair(best.band),
+            residual: twin.residual,
+            agrees_with_scores,
+            note,
+            fits: twin.fits.clone(),
+        }
+    }
 }
 
 /// The decision thresholds the verdict was reached with.
@@ -199,6 +255,7 @@ impl AnalyzeReport {
                     harmonics: h.score.peaks().to_vec(),
                 })
                 .collect(),
+            twin: None,
             warnings: context.warnings.clone(),
         }
     }

@@ -62,6 +62,39 @@ pub fn render_text(r: &AnalyzeReport) -> String {
             sidebands
         );
     }
+    if let Some(t) = &r.twin {
+        let p = &t.params;
+        let _ = writeln!(
+            out,
+            "  twin ({:.1} ms): {} fits best in {:.0}–{:.0} Hz, error {:.3} (margin {:.3}): a {:.3} g, B {:.0}/s, f_n {:.0} Hz, f_d {:.2} Hz (slip {:+.2} %), jitter {:.2} %",
+            t.fit_ms,
+            t.hypothesis.name(),
+            t.band_hz[0],
+            t.band_hz[1],
+            t.error,
+            t.margin,
+            p.a,
+            p.decay_per_s,
+            p.f_n,
+            p.f_d,
+            p.slip * 100.0,
+            p.jitter * 100.0
+        );
+        let errors: Vec<String> = t
+            .fits
+            .iter()
+            .map(|f| format!("{} {:.3}", f.fault.name(), f.error))
+            .collect();
+        let _ = writeln!(out, "    errors per hypothesis: {}", errors.join(", "));
+        let _ = writeln!(
+            out,
+            "    unexplained: {:.0} % of the envelope spectrum's energy; largest residual peak {:.1} Hz; time residual {:.2}",
+            t.residual.energy_ratio * 100.0,
+            t.residual.largest_peak_hz,
+            t.residual.time_energy_ratio
+        );
+        let _ = writeln!(out, "    {}", t.note);
+    }
     let i = &r.indicators;
     let _ = writeln!(
         out,

@@ -1,7 +1,13 @@
 //! The signal-model digital twin of the bearing (MODELS.md §4): a simulator of a localized
-//! defect's vibration, shared by every part that needs a synthetic signal.
+//! defect's vibration, shared by every part that needs a synthetic signal; the same model's
+//! envelope spectrum in closed form; and its fit to measured spectra, per fault hypothesis.
 
+pub mod diagnose;
+pub mod fit;
+pub mod model;
+pub mod optimize;
 pub mod rng;
 pub mod simulate;
 
+pub use fit::{FitBounds, HypothesisFit, TwinFitter, TwinParams};
 pub use simulate::{SimulatedFault, SimulationParams, Simulator};

@@ -160,7 +160,10 @@ struct Impact {
 /// Streams a simulated record block by block.
 pub struct Simulator {
     params: SimulationParams,
-    rng: Rng,
+    /// Separate streams for the noise and the impact jitter, so that the signal does not
+    /// depend on how it is cut into blocks.
+    noise_rng: Rng,
+    jitter_rng: Rng,
     next_sample: u64,
     next_impact_index: u64,
     ringing: Vec<Impact>,
@@ -172,7 +175,8 @@ impl Simulator {
     pub fn new(params: SimulationParams) -> Self {
         let ring_time_s = 12.0 / params.decay_per_s.max(1.0);
         Simulator {
-            rng: Rng::new(params.seed),
+            noise_rng: Rng::new(params.seed),
+            jitter_rng: Rng::new(params.seed ^ 0x5EED_0F11_77E5),
             params,
             next_sample: 0,
             next_impact_index: 0,
@@ -203,7 +207,7 @@ impl Simulator {
         let shaft_hz = p.rpm / 60.0;
         for (i, o) in out.iter_mut().enumerate() {
             let t = block_start_s + i as f64 / fs;
-            let mut x = p.noise_g * self.rng.normal();
+            let mut x = p.noise_g * self.noise_rng.normal();
             x += p.shaft_tone_g * (std::f64::consts::TAU * shaft_hz * t).sin();
             *o = x as f32;
         }
@@ -246,7 +250,7 @@ impl Simulator {
             if nominal > end_s + period {
                 break;
             }
-            let time_s = nominal + self.params.jitter * period * self.rng.normal();
+            let time_s = nominal + self.params.jitter * period * self.jitter_rng.normal();
             self.next_impact_index += 1;
             let amplitude = self.params.amplitude_g
                 * self.params.load_at(self.params.defect_angle(time_s))

@@ -233,3 +233,69 @@ fn validate_lists_every_problem_and_config_default_is_valid() {
         assert!(err.contains(key), "'{err}' lacks {key}");
     }
 }
+
+#[test]
+fn a_simulated_record_is_diagnosed_and_the_twin_reported() {
+    let dir = scratch_dir("cli-simulate");
+    for (out, extra) in [("outer.wav", vec![]), ("outer.csv", vec!["--fs", "12000"])] {
+        let path = dir.join(out);
+        let path = path.to_str().unwrap();
+        let made = bearingd(&[
+            "simulate",
+            "--fault",
+            "outer",
+            "--rpm",
+            "1772",
+            "--bearing",
+            "skf-6205-2rs",
+            "--duration",
+            "10s",
+            "--out",
+            path,
+        ]);
+        assert!(made.status.success(), "{}", stderr(&made));
+        let mut args = vec![
+            "analyze",
+            path,
+            "--rpm",
+            "1772",
+            "--bearing",
+            "skf-6205-2rs",
+            "--twin",
+            "--format",
+            "json",
+        ];
+        args.extend(extra);
+        let out = bearingd(&args);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(json["diagnosis"], "outer_race", "{json}");
+        let twin = &json["twin"];
+        assert_eq!(twin["hypothesis"], "outer_race");
+        for key in ["a", "B", "f_n"] {
+            assert!(twin["params"][key].as_f64().unwrap() > 0.0, "{key}");
+        }
+        for key in ["outer_race", "inner_race", "ball"] {
+            assert!(twin["errors"][key].as_f64().unwrap() >= 0.0, "{key}");
+        }
+        assert!(
+            twin["error"].as_f64().unwrap() < 0.1 && twin["margin"].as_f64().unwrap() > 0.1,
+            "{twin}"
+        );
+        assert!(twin["fit_ms"].as_f64().unwrap() > 0.0);
+    }
+    expect_input_error(
+        &["simulate", "--out", dir.join("x.mp3").to_str().unwrap()],
+        &["x.mp3", ".csv"],
+    );
+    expect_input_error(
+        &[
+            "simulate",
+            "--duration",
+            "ten",
+            "--out",
+            dir.join("x.csv").to_str().unwrap(),
+        ],
+        &["--duration ten"],
+    );
+}

@@ -5,3 +5,4 @@ mod cli;
 mod developer_set;
 mod envelope;
 mod kinematics;
+mod twin;

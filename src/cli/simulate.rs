@@ -1,0 +1,201 @@
+//! `bearingd simulate`: write a synthetic record of the twin's signal model, so that anyone can
+//! produce a known fault and check what bearingd makes of it.
+
+use super::CliError;
+use crate::bearing::BearingGeometry;
+use crate::twin::{SimulatedFault, SimulationParams, Simulator};
+use clap::{Args, ValueEnum};
+use std::io::Write;
+use std::path::PathBuf;
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum FaultArg {
+    None,
+    Outer,
+    Inner,
+    Ball,
+}
+
+#[derive(Args)]
+pub struct SimulateArgs {
+    /// The defect.
+    #[arg(long, value_enum, default_value = "outer")]
+    fault: FaultArg,
+    /// Shaft speed, rpm.
+    #[arg(long, default_value_t = 1772.0)]
+    rpm: f64,
+    /// Bearing: catalog name or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0".
+    #[arg(long, default_value = "skf-6205-2rs")]
+    bearing: String,
+    /// Length of the record: seconds, e.g. 10 or 10s.
+    #[arg(long, default_value = "10s")]
+    duration: String,
+    /// Sample rate, Hz.
+    #[arg(long, default_value_t = 12_000.0)]
+    fs: f64,
+    /// Output file: .csv (one column, g) or .wav (32-bit float, g).
+    #[arg(long)]
+    out: PathBuf,
+    /// Impact amplitude a at full load, g.
+    #[arg(long, default_value_t = 1.0)]
+    amplitude: f64,
+    /// Decay rate B of each impact, 1/s.
+    #[arg(long, default_value_t = 800.0)]
+    decay: f64,
+    /// Structural resonance f_n, Hz.
+    #[arg(long, default_value_t = 3_000.0)]
+    resonance: f64,
+    /// Stribeck load-zone factor ε (0.5: half the bearing loaded).
+    #[arg(long, default_value_t = 0.5)]
+    load_zone: f64,
+    /// Impact-time jitter (slip), as a fraction of the impact period.
+    #[arg(long, default_value_t = 0.01)]
+    jitter: f64,
+    /// Defect length in mm (0: one impact per passage; above: entry and exit impacts).
+    #[arg(long, default_value_t = 0.0)]
+    defect_length: f64,
+    /// White noise, g (standard deviation).
+    #[arg(long, default_value_t = 0.2)]
+    noise: f64,
+    /// The fault appears at this time, s.
+    #[arg(long, default_value_t = 0.0)]
+    onset: f64,
+    /// Random seed: the same seed gives the same record.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+fn parse_seconds(text: &str) -> Option<f64> {
+    let t = text.trim();
+    let value = t
+        .strip_suffix("ms")
+        .map(|v| v.trim().parse::<f64>().ok().map(|ms| ms / 1e3))
+        .unwrap_or_else(|| t.strip_suffix('s').unwrap_or(t).trim().parse::<f64>().ok())?;
+    (value.is_finite() && value > 0.0).then_some(value)
+}
+
+pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
+    let duration = parse_seconds(&args.duration).ok_or_else(|| {
+        CliError::input(format!(
+            "--duration {} is not a length of time; give seconds, e.g. --duration 10s",
+            args.duration
+        ))
+    })?;
+    let bearing = BearingGeometry::parse(&args.bearing).map_err(CliError::input)?;
+    let checks = [
+        (
+            args.rpm > 0.0 && args.rpm.is_finite(),
+            "--rpm must be a positive speed, e.g. --rpm 1772",
+        ),
+        (
+            args.fs >= 1_000.0 && args.fs <= 1e6,
+            "--fs must be a sample rate in [1000, 1000000] Hz, e.g. --fs 12000",
+        ),
+        (
+            args.resonance > 0.0 && args.resonance < args.fs / 2.0,
+            "--resonance must lie below half the sample rate",
+        ),
+        (
+            args.decay > 0.0,
+            "--decay must be positive, e.g. --decay 800",
+        ),
+        (
+            args.load_zone > 0.0,
+            "--load-zone must be positive, e.g. --load-zone 0.5",
+        ),
+        (
+            (0.0..0.5).contains(&args.jitter),
+            "--jitter must be in [0, 0.5), e.g. --jitter 0.01",
+        ),
+        (
+            args.noise >= 0.0 && args.amplitude >= 0.0 && args.defect_length >= 0.0,
+            "--noise, --amplitude and --defect-length must not be negative",
+        ),
+        (
+            duration * args.fs <= 1e9,
+            "--duration × --fs must stay below 10⁹ samples",
+        ),
+    ];
+    let problems: Vec<&str> = checks
+        .iter()
+        .filter(|(ok, _)| !ok)
+        .map(|(_, why)| *why)
+        .collect();
+    if !problems.is_empty() {
+        return Err(CliError::input(problems.join("; ")));
+    }
+    let params = SimulationParams {
+        fault: match args.fault {
+            FaultArg::None => SimulatedFault::None,
+            FaultArg::Outer => SimulatedFault::OuterRace,
+            FaultArg::Inner => SimulatedFault::InnerRace,
+            FaultArg::Ball => SimulatedFault::Ball,
+        },
+        rpm: args.rpm,
+        bearing: bearing.clone(),
+        fs_hz: args.fs,
+        amplitude_g: args.amplitude,
+        decay_per_s: args.decay,
+        resonance_hz: args.resonance,
+        load_zone: args.load_zone,
+        load_exponent: 1.5,
+        jitter: args.jitter,
+        defect_length_mm: args.defect_length,
+        noise_g: args.noise,
+        shaft_tone_g: 0.05,
+        onset_s: args.onset,
+        ramp_s: 0.0,
+        seed: args.seed,
+    };
+    let samples = Simulator::record(params, duration);
+    let extension = args
+        .out
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let written = match extension.as_deref() {
+        Some("wav") => write_wav(&args.out, args.fs, &samples),
+        Some("csv") => write_csv(&args.out, &samples),
+        _ => {
+            return Err(CliError::input(format!(
+                "{}: unsupported output; use a .csv or .wav file name",
+                args.out.display()
+            )))
+        }
+    };
+    written.map_err(|e| CliError::failure(format!("{}: cannot write: {e}", args.out.display())))?;
+    eprintln!(
+        "wrote {} samples ({duration} s at {} Hz) to {}; analyse with: bearingd analyze {}{} --rpm {} --bearing {}",
+        samples.len(),
+        args.fs,
+        args.out.display(),
+        args.out.display(),
+        if extension.as_deref() == Some("csv") { format!(" --fs {}", args.fs) } else { String::new() },
+        args.rpm,
+        args.bearing
+    );
+    Ok(())
+}
+
+fn write_wav(path: &PathBuf, fs: f64, samples: &[f32]) -> std::io::Result<()> {
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: fs.round() as u32,
+        bits_per_sample: 32,
+        sample_format: hound::SampleFormat::Float,
+    };
+    let mut writer = hound::WavWriter::create(path, spec).map_err(std::io::Error::other)?;
+    for &s in samples {
+        writer.write_sample(s).map_err(std::io::Error::other)?;
+    }
+    writer.finalize().map_err(std::io::Error::other)
+}
+
+fn write_csv(path: &PathBuf, samples: &[f32]) -> std::io::Result<()> {
+    let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
+    writeln!(out, "accel_g")?;
+    for s in samples {
+        writeln!(out, "{s}")?;
+    }
+    out.flush()
+}

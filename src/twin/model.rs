@@ -1,0 +1,299 @@
+//! The twin's squared-envelope spectrum in closed form (MODELS.md §4), on the same bins and in
+//! the same units as the measured Welch spectrum ([`crate::analysis::envelope`]).
+//!
+//! Why closed form: a fit evaluates the twin hundreds of times; simulating the time signal and
+//! transforming it each time costs milliseconds per evaluation, the expression below costs
+//! microseconds.
+//!
+//! The derivation, for impacts `a·q_k` at `t_k = k·T + τ_k` (Gaussian jitter of standard
+//! deviation `σ`), each ringing as `e^{−Bt}·sin(2π f_n t)`, band-passed to `[lo, hi]`:
+//!
+//! - one impact's squared analytic envelope `p(t) = |g(t)|²` has the transform
+//!   `P(f) = ∫ G(ν+f) G*(ν) dν` over the band, which with `G(ν) = 1/(i(B + i2π(ν − f_n)))`
+//!   integrates to
+//!   `P(f) = [ln(B + i2π(u+f)) − ln(B − i2πu)]_{u=lo−f_n}^{hi−f−f_n} / (i2π (2B + i2πf))`
+//!   (`1/(2B + i2πf)` when the band holds the whole resonance);
+//! - the load `q(θ)` of the defect's angle, squared, has Fourier coefficients `Q_l` over the
+//!   modulation (the shaft for an inner race, the cage for a ball, none for an outer race), so
+//!   the envelope has lines at `m·f_d + l·f_mod` of amplitude `2·a²·f_d·|Q_l·P(f)|`, reduced by
+//!   the jitter's `e^{−(2πfσ)²/2}`; each line is spread over the bins by the Hann window's kernel;
+//! - the power the jitter takes from the lines becomes a continuum of two-sided density
+//!   `f_d·a⁴·mean(Q²)·|P(f)|²·(1 − e^{−(2πfσ)²})`, which a Hann-windowed Welch bin sees as
+//!   `6·Δf` times the density;
+//! - the band's noise adds a floor shaped like its own autocorrelation, `1 − f/bandwidth`.
+//!
+//! So the twin's power spectrum is `a⁴·U(f; f_d, B, f_n, σ) + c·N(f)`: linear in `a⁴` and the
+//! noise level `c`, non-linear in the rest. [`EnvelopeModel::basis`] computes `U` and `N`.
+
+use crate::analysis::{Band, FaultKind};
+use crate::bearing::FaultFrequencies;
+use rustfft::num_complex::Complex64;
+use std::f64::consts::{PI, TAU};
+
+/// The shape parameters of the twin (everything but the amplitude and the noise level).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ShapeParams {
+    /// Impact rate `f_d` in Hz (the fault frequency including slip).
+    pub impact_rate_hz: f64,
+    /// Decay rate `B`, 1/s.
+    pub decay_per_s: f64,
+    /// Resonance `f_n`, Hz.
+    pub resonance_hz: f64,
+    /// Jitter standard deviation as a fraction of the impact period.
+    pub jitter: f64,
+}
+
+/// Harmonics of the load modulation kept (`l = −L..=L`).
+const MODULATION_ORDERS: i32 = 8;
+/// Bins on each side of a line that its Hann kernel reaches.
+const KERNEL_HALF_WIDTH: i32 = 3;
+
+/// Everything about one fault hypothesis that does not change during a fit.
+#[derive(Debug, Clone)]
+pub struct EnvelopeModel {
+    pub fault: FaultKind,
+    pub band: Band,
+    pub bin_hz: f64,
+    pub bins: usize,
+    /// Frequency of the load modulation (0 for an outer race).
+    modulation_hz: f64,
+    /// `Q_l` for `l = −L..=L` (index `l + L`).
+    load_coefficients: Vec<Complex64>,
+    /// Mean of `q⁴` over the modulation.
+    load_fourth_moment: f64,
+    /// Modulation orders that carry power (`|Q_l|² > 10⁻⁵·|Q_0|²`), at most [`MODULATION_ORDERS`].
+    orders: i32,
+}
+
+/// Stribeck load `q(θ)/q_max` (MODELS.md §4).
+pub fn stribeck_load(theta: f64, load_zone: f64, exponent: f64) -> f64 {
+    let inner = 1.0 - (1.0 - theta.cos()) / (2.0 * load_zone);
+    if inner > 0.0 {
+        inner.powf(exponent)
+    } else {
+        0.0
+    }
+}
+
+impl EnvelopeModel {
+    /// `load_zone` ε and `load_exponent` n of the Stribeck distribution; the defect starts on
+    /// the load line.
+    pub fn new(
+        fault: FaultKind,
+        freqs: &FaultFrequencies,
+        band: Band,
+        bin_hz: f64,
+        bins: usize,
+        load_zone: f64,
+        load_exponent: f64,
+    ) -> Self {
+        let modulation_hz = match fault {
+            FaultKind::InnerRace => freqs.shaft,
+            FaultKind::Ball => freqs.ftf,
+            FaultKind::OuterRace | FaultKind::Cage => 0.0,
+        };
+        const STEPS: usize = 360;
+        let squared_load: Vec<f64> = (0..STEPS)
+            .map(|i| {
+                let theta = if modulation_hz > 0.0 {
+                    TAU * i as f64 / STEPS as f64
+                } else {
+                    0.0
+                };
+                stribeck_load(theta, load_zone, load_exponent).powi(2)
+            })
+            .collect();
+        let load_coefficients: Vec<Complex64> = (-MODULATION_ORDERS..=MODULATION_ORDERS)
+            .map(|l| {
+                squared_load
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &q2)| {
+                        Complex64::from_polar(q2, -f64::from(l) * TAU * i as f64 / STEPS as f64)
+                    })
+                    .sum::<Complex64>()
+                    / STEPS as f64
+            })
+            .collect();
+        let load_fourth_moment = squared_load.iter().map(|q2| q2 * q2).sum::<f64>() / STEPS as f64;
+        let coefficient_power = |l: i32| load_coefficients_power(&load_coefficients, l);
+        let orders = if modulation_hz > 0.0 {
+            (1..=MODULATION_ORDERS)
+                .rev()
+                .find(|&l| coefficient_power(l) > 1e-5 * coefficient_power(0))
+                .unwrap_or(0)
+        } else {
+            0
+        };
+        EnvelopeModel {
+            fault,
+            band,
+            bin_hz,
+            bins,
+            modulation_hz,
+            load_coefficients,
+            load_fourth_moment,
+            orders,
+        }
+    }
+
+    /// Transform of one impact's squared band-limited envelope at envelope frequency `f`.
+    pub fn impact_envelope_transform(&self, f: f64, decay: f64, resonance: f64) -> Complex64 {
+        let u_low = self.band.lo_hz - resonance;
+        let u_high = self.band.hi_hz - f - resonance;
+        if u_high <= u_low {
+            return Complex64::new(0.0, 0.0);
+        }
+        let alpha = Complex64::new(decay, TAU * f);
+        let term = |u: f64| {
+            (alpha + Complex64::new(0.0, TAU * u)).ln() - Complex64::new(decay, -TAU * u).ln()
+        };
+        (term(u_high) - term(u_low))
+            / (Complex64::new(0.0, TAU) * Complex64::new(2.0 * decay, TAU * f))
+    }
+
+    /// Writes the unit-amplitude twin spectrum `U` and the noise shape `N` into the two
+    /// slices (`bins` values each, power per bin as in the Welch spectrum).
+    ///
+    /// `|P(f)|²` is smooth in `f` (its scale is the decay rate, hundreds of Hz), so it is
+    /// evaluated on a coarse grid and interpolated; this keeps an evaluation at a few
+    /// microseconds.
+    pub fn basis(&self, params: &ShapeParams, twin: &mut [f64], noise: &mut [f64]) {
+        twin.iter_mut().for_each(|v| *v = 0.0);
+        let f_d = params.impact_rate_hz;
+        let sigma_t = params.jitter / f_d.max(1e-9);
+        let top_hz = self.bins as f64 * self.bin_hz;
+        let jitter_power = |f: f64| (-(TAU * f * sigma_t).powi(2)).exp();
+        let mut grid = [0f64; GRID_POINTS + 1];
+        let grid_step = top_hz / GRID_POINTS as f64;
+        for (i, g) in grid.iter_mut().enumerate() {
+            *g = self
+                .impact_envelope_transform(
+                    i as f64 * grid_step,
+                    params.decay_per_s,
+                    params.resonance_hz,
+                )
+                .norm_sqr();
+        }
+        let transform_power = |f: f64| {
+            let x = (f / grid_step).clamp(0.0, GRID_POINTS as f64);
+            let i = (x as usize).min(GRID_POINTS - 1);
+            let t = x - i as f64;
+            grid[i] * (1.0 - t) + grid[i + 1] * t
+        };
+
+        // Lines at m·f_d + l·f_mod.
+        let max_m = (top_hz / f_d).ceil() as i32 + 1;
+        let orders = self.orders;
+        for m in 0..=max_m {
+            for l in -orders..=orders {
+                let f = f64::from(m) * f_d + f64::from(l) * self.modulation_hz;
+                if f <= 0.5 * self.bin_hz || f >= top_hz {
+                    continue;
+                }
+                let q = self.load_coefficients[(l + MODULATION_ORDERS) as usize].norm_sqr();
+                let power = 4.0 * q * f_d * f_d * transform_power(f) * jitter_power(f);
+                self.spread_line(f, power, twin);
+            }
+        }
+        // The continuum the jitter makes.
+        let continuum_scale = 6.0 * self.bin_hz * f_d * self.load_fourth_moment;
+        let bandwidth = self.band.width_hz();
+        // e^{−c·k²} by recurrence: e^{−c(k+1)²} = e^{−ck²}·e^{−c(2k+1)}.
+        let c = (TAU * self.bin_hz * sigma_t).powi(2);
+        let (mut gaussian, mut step, step_ratio) = (1.0, (-c).exp(), (-2.0 * c).exp());
+        let grid_per_bin = self.bin_hz / grid_step;
+        let noise_per_bin = self.bin_hz / bandwidth;
+        for (k, (t, n)) in twin.iter_mut().zip(noise.iter_mut()).enumerate() {
+            let x = k as f64 * grid_per_bin;
+            let i = (x as usize).min(GRID_POINTS - 1);
+            let frac = x - i as f64;
+            let transform = grid[i] + (grid[i + 1] - grid[i]) * frac;
+            *t += continuum_scale * transform * (1.0 - gaussian);
+            gaussian *= step;
+            step *= step_ratio;
+            *n = (1.0 - k as f64 * noise_per_bin).max(0.0);
+        }
+        twin[0] = 0.0;
+    }
+
+    /// Adds a line of `power` at `f` to the bins its Hann kernel reaches. `sin(π(k − c))` has
+    /// the same magnitude for every bin `k`, so one sine serves the whole kernel.
+    fn spread_line(&self, f: f64, power: f64, out: &mut [f64]) {
+        let centre = f / self.bin_hz;
+        let nearest = centre.round();
+        let sine = (PI * (centre - nearest)).sin().abs();
+        for j in -KERNEL_HALF_WIDTH..=KERNEL_HALF_WIDTH {
+            let k = nearest + f64::from(j);
+            if k < 1.0 {
+                continue;
+            }
+            if let Some(slot) = out.get_mut(k as usize) {
+                *slot += power * hann_kernel_with_sine(k - centre, sine);
+            }
+        }
+    }
+}
+
+fn load_coefficients_power(coefficients: &[Complex64], l: i32) -> f64 {
+    coefficients[(l + MODULATION_ORDERS) as usize].norm_sqr()
+}
+
+/// Points of the coarse grid on which `|P(f)|²` is evaluated.
+const GRID_POINTS: usize = 40;
+
+/// [`hann_kernel`] given `|sin(π δ)|`.
+fn hann_kernel_with_sine(delta: f64, sine: f64) -> f64 {
+    let d = delta.abs();
+    if d < 1e-9 {
+        return 1.0;
+    }
+    if (d - 1.0).abs() < 1e-9 {
+        return 0.25;
+    }
+    (sine / (PI * d * (1.0 - d * d))).powi(2)
+}
+
+/// Power response of a periodic Hann window to a line `delta` bins away, normalised to 1 on
+/// the line: `[sinc(δ)/(1 − δ²)]²`.
+pub fn hann_kernel(delta: f64) -> f64 {
+    hann_kernel_with_sine(delta, (PI * delta).sin().abs())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wide_band_transform_is_the_plain_exponential() {
+        let freqs = crate::bearing::BearingGeometry::from_catalog("skf-6205-2rs")
+            .unwrap()
+            .fault_frequencies(29.5);
+        let model = EnvelopeModel::new(
+            FaultKind::OuterRace,
+            &freqs,
+            Band::new(0.0, 1e7),
+            1.0,
+            10,
+            0.5,
+            1.5,
+        );
+        for f in [0.0, 50.0, 500.0] {
+            let p = model.impact_envelope_transform(f, 800.0, 3_000.0);
+            let expected = Complex64::new(1.0, 0.0) / Complex64::new(1600.0, TAU * f);
+            assert!(
+                (p - expected).norm() < 1e-3 * expected.norm(),
+                "{f}: {p} vs {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn hann_kernel_values() {
+        assert_eq!(hann_kernel(0.0), 1.0);
+        assert!((hann_kernel(1.0) - 0.25).abs() < 1e-12);
+        assert!((hann_kernel(0.999_999) - 0.25).abs() < 1e-5);
+        assert!(hann_kernel(2.0) < 1e-12);
+        assert!((hann_kernel(0.5) - (2.0 / PI / 0.75f64).powi(2)).abs() < 1e-12);
+    }
+}
