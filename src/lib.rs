@@ -22,6 +22,7 @@ pub mod analysis;
 pub mod bearing;
 pub mod cli;
 pub mod config;
+pub mod daemon;
 pub mod offline;
 pub mod plot;
 pub mod recording;
