@@ -37,7 +37,12 @@ fn rolling_envelope_and_scoring_never_allocate_per_hop() {
         .unwrap()
         .fault_frequencies(1772.0 / 60.0);
     let bins = 1_200;
-    let mut rolling = RollingEnvelope::new(fs, 16_384, 4_096, 8, Band::new(2_000.0, 6_000.0), bins);
+    let bands = [
+        Band::new(2_000.0, 6_000.0),
+        Band::new(1_000.0, 3_000.0),
+        Band::new(3_000.0, 4_000.0),
+    ];
+    let mut rolling = RollingEnvelope::new(fs, 16_384, 4_096, 8, &bands, bins);
     let mut scorer = FaultScorer::new(0.02, 3, bins);
     let signal: Vec<f32> = (0..(fs as usize * 4))
         .map(|n| ((n as f32) * 0.37).sin() * ((n % 241) as f32 / 241.0))
@@ -51,8 +56,10 @@ fn rolling_envelope_and_scoring_never_allocate_per_hop() {
     for block in signal[16_384..].chunks(256) {
         rolling.push(block, |u| {
             updates += 1;
-            for score in scorer.score_all(u.averaged_amplitude, u.bin_hz, &freqs) {
-                best = f64::max(best, score.score);
+            for band in u.bands {
+                for score in scorer.score_all(band.averaged_amplitude(), u.bin_hz, &freqs) {
+                    best = f64::max(best, score.score);
+                }
             }
         });
     }

@@ -331,43 +331,64 @@ pub fn welch_envelope_spectrum(
     }
 }
 
+/// One band of the rolling form: its envelope engine, the newest spectrum and the average.
+pub struct RollingBand {
+    envelope: BandEnvelope,
+    latest: Vec<f32>,
+    /// `averages` power spectra, oldest overwritten first.
+    history: Vec<f32>,
+    averaged: Vec<f32>,
+}
+
+impl RollingBand {
+    pub fn band(&self) -> Band {
+        self.envelope.band()
+    }
+
+    /// The newest window's power spectrum.
+    pub fn latest_power(&self) -> &[f32] {
+        &self.latest
+    }
+
+    /// The average over the last windows, as amplitude (g²).
+    pub fn averaged_amplitude(&self) -> &[f32] {
+        &self.averaged
+    }
+}
+
 /// One update of the rolling envelope spectrum, handed to the caller every hop.
 pub struct EnvelopeUpdate<'a> {
     /// Sample index (in the channel's sample time) one past the last sample of the window.
     pub end_sample: u64,
-    pub band: Band,
     pub bin_hz: f64,
-    /// The newest window's power spectrum.
-    pub latest_power: &'a [f32],
-    /// The average over the last `windows_averaged` windows, as amplitude.
-    pub averaged_amplitude: &'a [f32],
+    /// How many windows the averages hold.
     pub windows_averaged: usize,
+    pub bands: &'a [RollingBand],
     /// The raw samples of the newest window, oldest first, as two slices of the ring buffer.
     pub window_samples: (&'a [f32], &'a [f32]),
 }
 
-/// Rolling form: a ring buffer of the last window of samples; every hop, the envelope
-/// spectrum of the newest window and the average of the last `averages` windows.
+/// Rolling form: a ring buffer of the last window of samples; every hop, for each band, the
+/// envelope spectrum of the newest window and the average of the last `averages` windows. The
+/// window's FFT is shared by the bands.
 ///
-/// All memory is allocated in [`RollingEnvelope::new`] and [`RollingEnvelope::set_band`];
+/// All memory is allocated in [`RollingEnvelope::new`] and [`RollingEnvelope::set_bands`];
 /// [`RollingEnvelope::push`] never allocates (tested with a counting allocator).
 pub struct RollingEnvelope {
     fs_hz: f64,
     hop: usize,
+    averages: usize,
+    spectrum_bins: usize,
     ring: Vec<f32>,
     /// Index in `ring` where the next sample goes; also where the oldest sample is once full.
     write_at: usize,
-    filled: usize,
     until_update: usize,
     samples_seen: u64,
     transform: WindowTransform,
-    band: BandEnvelope,
     plans: FftPlans,
-    latest: Vec<f32>,
-    history: Vec<f32>,
+    bands: Vec<RollingBand>,
     history_used: usize,
     history_next: usize,
-    averaged: Vec<f32>,
 }
 
 impl RollingEnvelope {
@@ -376,57 +397,70 @@ impl RollingEnvelope {
         window: usize,
         hop: usize,
         averages: usize,
-        band: Band,
+        bands: &[Band],
         spectrum_bins: usize,
     ) -> Self {
         let mut plans = FftPlans::default();
         let transform = WindowTransform::new(window, &mut plans);
-        let band = BandEnvelope::new(band, fs_hz, window, spectrum_bins, &mut plans);
-        let averages = averages.max(1);
-        RollingEnvelope {
+        let mut rolling = RollingEnvelope {
             fs_hz,
             hop: hop.clamp(1, window),
+            averages: averages.max(1),
+            spectrum_bins,
             ring: vec![0.0; window],
             write_at: 0,
-            filled: 0,
             until_update: window,
             samples_seen: 0,
             transform,
-            band,
             plans,
-            latest: vec![0.0; spectrum_bins],
-            history: vec![0.0; averages * spectrum_bins],
+            bands: Vec::new(),
             history_used: 0,
             history_next: 0,
-            averaged: vec![0.0; spectrum_bins],
-        }
+        };
+        rolling.set_bands(bands);
+        rolling
     }
 
-    pub fn band(&self) -> Band {
-        self.band.band()
+    pub fn bands(&self) -> &[RollingBand] {
+        &self.bands
     }
 
     pub fn window(&self) -> usize {
         self.ring.len()
     }
 
+    pub fn hop(&self) -> usize {
+        self.hop
+    }
+
+    pub fn bin_hz(&self) -> f64 {
+        self.fs_hz / self.ring.len() as f64
+    }
+
     pub fn samples_seen(&self) -> u64 {
         self.samples_seen
     }
 
-    /// Switches to another band (allocates; meant for the periodic band re-selection, not
-    /// per hop). The average restarts, since spectra of different bands do not mix.
-    pub fn set_band(&mut self, band: Band) {
-        let bins = self.latest.len();
-        self.band = BandEnvelope::new(band, self.fs_hz, self.ring.len(), bins, &mut self.plans);
+    /// Switches to other bands (allocates; meant for the periodic band re-selection, not per
+    /// hop). The averages restart, since spectra of different bands do not mix.
+    pub fn set_bands(&mut self, bands: &[Band]) {
+        let (bins, averages, window) = (self.spectrum_bins, self.averages, self.ring.len());
+        self.bands = bands
+            .iter()
+            .map(|&band| RollingBand {
+                envelope: BandEnvelope::new(band, self.fs_hz, window, bins, &mut self.plans),
+                latest: vec![0.0; bins],
+                history: vec![0.0; averages * bins],
+                averaged: vec![0.0; bins],
+            })
+            .collect();
         self.history_used = 0;
         self.history_next = 0;
     }
 
     /// Forgets the buffered samples (after a gap in the signal: a window must never straddle
-    /// a gap) and restarts the average. `next_sample` is the sample index of the next sample.
+    /// a gap) and restarts the averages. `next_sample` is the sample index of the next sample.
     pub fn restart_at(&mut self, next_sample: u64) {
-        self.filled = 0;
         self.write_at = 0;
         self.until_update = self.ring.len();
         self.samples_seen = next_sample;
@@ -445,7 +479,6 @@ impl RollingEnvelope {
             self.ring[self.write_at..self.write_at + take].copy_from_slice(&samples[..take]);
             samples = &samples[take..];
             self.write_at = (self.write_at + take) % window;
-            self.filled = (self.filled + take).min(window);
             self.until_update -= take;
             self.samples_seen += take as u64;
             if self.until_update == 0 {
@@ -458,34 +491,32 @@ impl RollingEnvelope {
     fn update(&mut self, on_update: &mut impl FnMut(&EnvelopeUpdate)) {
         let (newer, older) = self.ring.split_at(self.write_at);
         let spectrum = self.transform.transform(older, newer);
-        self.band.process(spectrum, &mut self.latest);
-
-        let bins = self.latest.len();
-        let slots = self.history.len() / bins;
-        let slot = self.history_next * bins;
-        self.history[slot..slot + bins].copy_from_slice(&self.latest);
-        self.history_next = (self.history_next + 1) % slots;
-        self.history_used = (self.history_used + 1).min(slots);
-        // Recomputed from the history each hop (not a running sum) so that rounding never drifts
-        // over months of operation.
-        self.averaged.fill(0.0);
-        for past in self.history.chunks_exact(bins).take(self.history_used) {
-            for (a, p) in self.averaged.iter_mut().zip(past) {
-                *a += p;
+        let slot = self.history_next;
+        self.history_next = (self.history_next + 1) % self.averages;
+        self.history_used = (self.history_used + 1).min(self.averages);
+        for band in &mut self.bands {
+            band.envelope.process(spectrum, &mut band.latest);
+            let bins = band.latest.len();
+            band.history[slot * bins..(slot + 1) * bins].copy_from_slice(&band.latest);
+            // Recomputed from the history each hop (not a running sum) so that rounding never
+            // drifts over months of operation.
+            band.averaged.fill(0.0);
+            for past in band.history.chunks_exact(bins).take(self.history_used) {
+                for (a, p) in band.averaged.iter_mut().zip(past) {
+                    *a += p;
+                }
             }
-        }
-        let scale = 1.0 / self.history_used as f32;
-        for a in &mut self.averaged {
-            *a = (*a * scale).sqrt();
+            let scale = 1.0 / self.history_used as f32;
+            for a in &mut band.averaged {
+                *a = (*a * scale).sqrt();
+            }
         }
         let (newer, older) = self.ring.split_at(self.write_at);
         on_update(&EnvelopeUpdate {
             end_sample: self.samples_seen,
-            band: self.band.band(),
             bin_hz: self.fs_hz / self.ring.len() as f64,
-            latest_power: &self.latest,
-            averaged_amplitude: &self.averaged,
             windows_averaged: self.history_used,
+            bands: &self.bands,
             window_samples: (older, newer),
         });
     }

@@ -131,7 +131,7 @@ fn rolling_average_equals_batch_welch_whatever_the_block_sizes() {
     let band = Band::new(2_000.0, 4_000.0);
     let x = am_signal(40_960, fs, 3_000.0, 105.0, 0.5, 5);
     let batch = welch_envelope_spectrum(&mut FftPlans::default(), &x, fs, band, window, 0.5, bins);
-    let mut rolling = RollingEnvelope::new(fs, window, hop, 1_000, band, bins);
+    let mut rolling = RollingEnvelope::new(fs, window, hop, 1_000, &[band], bins);
     let mut rng = Rng::new(9);
     let mut rest = &x[..];
     let mut last: Option<(u64, Vec<f32>, usize)> = None;
@@ -140,7 +140,7 @@ fn rolling_average_equals_batch_welch_whatever_the_block_sizes() {
         rolling.push(&rest[..take], |u| {
             last = Some((
                 u.end_sample,
-                u.averaged_amplitude.to_vec(),
+                u.bands[0].averaged_amplitude().to_vec(),
                 u.windows_averaged,
             ))
         });
