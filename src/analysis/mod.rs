@@ -16,6 +16,8 @@ pub mod band;
 pub mod diagnosis;
 pub mod envelope;
 pub mod fault_bands;
+pub mod flags;
+pub mod health;
 pub mod indicators;
 pub mod kurtogram;
 pub mod record;
