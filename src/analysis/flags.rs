@@ -55,7 +55,11 @@ pub struct FaultFlag {
 
 impl FaultFlag {
     pub fn new(settings: FlagSettings) -> Self {
-        FaultFlag { settings, level: FlagLevel::Ok, pending: None }
+        FaultFlag {
+            settings,
+            level: FlagLevel::Ok,
+            pending: None,
+        }
     }
 
     pub fn level(&self) -> FlagLevel {
@@ -104,13 +108,25 @@ impl FaultFlag {
         // The same wish keeps its start; so does a rise that turns into a higher rise (a
         // fast-growing fault is not delayed twice); anything else starts its delay now.
         let since = match self.pending {
-            Some((level, since)) if level == wanted || (level > self.level && wanted > self.level) => since,
+            Some((level, since))
+                if level == wanted || (level > self.level && wanted > self.level) =>
+            {
+                since
+            }
             _ => end_sample,
         };
         self.pending = Some((wanted, since));
-        let delay = if wanted > self.level { self.settings.on_delay_samples } else { self.settings.off_delay_samples };
+        let delay = if wanted > self.level {
+            self.settings.on_delay_samples
+        } else {
+            self.settings.off_delay_samples
+        };
         if end_sample.saturating_sub(since) >= delay {
-            let change = FlagChange { from: self.level, to: wanted, at_sample: end_sample };
+            let change = FlagChange {
+                from: self.level,
+                to: wanted,
+                at_sample: end_sample,
+            };
             self.level = wanted;
             self.pending = None;
             return Some(change);
@@ -124,7 +140,13 @@ mod tests {
     use super::*;
 
     fn settings() -> FlagSettings {
-        FlagSettings { watch_score: 10.0, alarm_score: 15.0, clear_ratio: 0.8, on_delay_samples: 100, off_delay_samples: 300 }
+        FlagSettings {
+            watch_score: 10.0,
+            alarm_score: 15.0,
+            clear_ratio: 0.8,
+            on_delay_samples: 100,
+            off_delay_samples: 300,
+        }
     }
 
     #[test]
@@ -133,7 +155,10 @@ mod tests {
         assert_eq!(flag.update(20.0, 1_000), None);
         assert_eq!(flag.update(20.0, 1_050), None);
         let change = flag.update(20.0, 1_100).unwrap();
-        assert_eq!((change.from, change.to, change.at_sample), (FlagLevel::Ok, FlagLevel::Alarm, 1_100));
+        assert_eq!(
+            (change.from, change.to, change.at_sample),
+            (FlagLevel::Ok, FlagLevel::Alarm, 1_100)
+        );
     }
 
     #[test]

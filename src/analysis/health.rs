@@ -88,8 +88,19 @@ pub struct HealthTracker {
 }
 
 impl HealthTracker {
-    pub fn new(baseline_windows: u64, sigma: f64, confirm_windows: u32, stored: Option<Baseline>) -> Self {
-        HealthTracker { baseline_windows: baseline_windows.max(2), sigma, confirm_windows: confirm_windows.max(1), baseline: stored.unwrap_or_default(), beyond: 0 }
+    pub fn new(
+        baseline_windows: u64,
+        sigma: f64,
+        confirm_windows: u32,
+        stored: Option<Baseline>,
+    ) -> Self {
+        HealthTracker {
+            baseline_windows: baseline_windows.max(2),
+            sigma,
+            confirm_windows: confirm_windows.max(1),
+            baseline: stored.unwrap_or_default(),
+            beyond: 0,
+        }
     }
 
     pub fn stage(&self) -> HealthStage {
@@ -109,18 +120,21 @@ impl HealthTracker {
         let next = match stage {
             HealthStage::Learning => {
                 self.baseline.kurtosis.add(kurtosis);
-                (self.baseline.kurtosis.count >= self.baseline_windows).then_some(HealthStage::Healthy)
+                (self.baseline.kurtosis.count >= self.baseline_windows)
+                    .then_some(HealthStage::Healthy)
             }
             HealthStage::Healthy => {
                 let limit = self.baseline.kurtosis.mean + self.sigma * self.baseline.kurtosis.std();
-                self.confirmed(kurtosis > limit).then_some(HealthStage::Degrading)
+                self.confirmed(kurtosis > limit)
+                    .then_some(HealthStage::Degrading)
             }
             HealthStage::Degrading => {
                 if self.baseline.aging_rms.count < self.baseline_windows {
                     self.baseline.aging_rms.add(rms);
                     None
                 } else {
-                    let limit = self.baseline.aging_rms.mean + self.sigma * self.baseline.aging_rms.std();
+                    let limit =
+                        self.baseline.aging_rms.mean + self.sigma * self.baseline.aging_rms.std();
                     self.confirmed(rms > limit).then_some(HealthStage::Failing)
                 }
             }
@@ -129,7 +143,11 @@ impl HealthTracker {
         next.map(|to| {
             self.baseline.stage = Some(to);
             self.beyond = 0;
-            StageChange { from: stage, to, at_sample: end_sample }
+            StageChange {
+                from: stage,
+                to,
+                at_sample: end_sample,
+            }
         })
     }
 
@@ -148,7 +166,11 @@ mod tests {
         let mut tracker = HealthTracker::new(20, 3.0, 3, None);
         let mut changes = Vec::new();
         let mut sample = 0;
-        let mut feed = |tracker: &mut HealthTracker, k: f64, r: f64, n: usize, changes: &mut Vec<StageChange>| {
+        let mut feed = |tracker: &mut HealthTracker,
+                        k: f64,
+                        r: f64,
+                        n: usize,
+                        changes: &mut Vec<StageChange>| {
             for i in 0..n {
                 sample += 100;
                 let wobble = if i % 2 == 0 { 0.05 } else { -0.05 };
@@ -158,16 +180,31 @@ mod tests {
         feed(&mut tracker, 3.0, 0.1, 20, &mut changes);
         assert_eq!(tracker.stage(), HealthStage::Healthy);
         feed(&mut tracker, 3.0, 0.1, 50, &mut changes);
-        assert_eq!(tracker.stage(), HealthStage::Healthy, "normal wobble keeps it healthy");
+        assert_eq!(
+            tracker.stage(),
+            HealthStage::Healthy,
+            "normal wobble keeps it healthy"
+        );
         feed(&mut tracker, 8.0, 0.12, 2, &mut changes);
-        assert_eq!(tracker.stage(), HealthStage::Healthy, "two windows are not enough");
+        assert_eq!(
+            tracker.stage(),
+            HealthStage::Healthy,
+            "two windows are not enough"
+        );
         feed(&mut tracker, 8.0, 0.12, 3, &mut changes);
         assert_eq!(tracker.stage(), HealthStage::Degrading);
         feed(&mut tracker, 8.0, 0.12, 25, &mut changes);
         feed(&mut tracker, 8.0, 0.5, 3, &mut changes);
         assert_eq!(tracker.stage(), HealthStage::Failing);
         let stages: Vec<_> = changes.iter().map(|c| c.to).collect();
-        assert_eq!(stages, [HealthStage::Healthy, HealthStage::Degrading, HealthStage::Failing]);
+        assert_eq!(
+            stages,
+            [
+                HealthStage::Healthy,
+                HealthStage::Degrading,
+                HealthStage::Failing
+            ]
+        );
     }
 
     #[test]

@@ -20,6 +20,7 @@ pub mod flags;
 pub mod health;
 pub mod indicators;
 pub mod kurtogram;
+pub mod monitor;
 pub mod record;
 pub mod settings;
 

@@ -5,4 +5,5 @@ mod cli;
 mod developer_set;
 mod envelope;
 mod kinematics;
+mod monitor;
 mod twin;

@@ -1,0 +1,420 @@
+//! One channel, streaming: the daemon's and the replay's analysis of a sensor axis, sans-IO.
+//!
+//! Samples go in with their sample index; events come out: every hop the indicators and fault
+//! scores, flag changes, health-stage changes, sensor-health findings, band re-selections.
+//! Every decision is taken in sample time, so a replay of the raw samples reproduces every event
+//! at the same sample (the replay test checks it).
+//!
+//! - Bands: every `band_period_samples` the last `band_history_samples` go through the same
+//!   whole-record analysis as `bearingd analyze` (kurtogram/GK plus per-fault SNR refinement),
+//!   and the rolling envelope follows one band per fault kind. Until the first selection the
+//!   channel is learning and raises no flag.
+//! - Scores, flags: each fault's score comes from its own band's averaged envelope spectrum and
+//!   drives that fault's flag.
+//! - Health: the stage tracker, fed with each window's kurtosis and RMS.
+//! - Sensor: clipping (counts at full scale) and a flat line (no change for a second) are
+//!   reported when they start and when they end.
+//!
+//! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
+
+use super::envelope::{window_samples, RollingEnvelope};
+use super::fault_bands::{FaultKind, FaultScore, FaultScorer};
+use super::flags::{FaultFlag, FlagChange, FlagSettings};
+use super::health::{Baseline, HealthTracker, StageChange};
+use super::indicators::Indicators;
+use super::record::{envelope_range_hz, RecordAnalyzer};
+use super::{AnalysisSettings, Band};
+use crate::bearing::FaultFrequencies;
+
+/// Everything a monitor needs, with durations already in samples.
+#[derive(Debug, Clone)]
+pub struct MonitorSettings {
+    pub fs_hz: f64,
+    pub analysis: AnalysisSettings,
+    pub band_period_samples: u64,
+    pub band_history_samples: usize,
+    pub flags: FlagSettings,
+    pub baseline_windows: u64,
+    pub sigma: f64,
+    /// A count whose magnitude reaches this is clipped (i16 full scale: 32767).
+    pub clip_count: i32,
+    /// Samples without any change that make a flat line.
+    pub flat_line_samples: u64,
+}
+
+/// A sensor-health finding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SensorCondition {
+    Clipping,
+    FlatLine,
+}
+
+impl SensorCondition {
+    pub fn name(self) -> &'static str {
+        match self {
+            SensorCondition::Clipping => "saturation",
+            SensorCondition::FlatLine => "flat_line",
+        }
+    }
+}
+
+/// One hop's results.
+pub struct WindowReport<'a> {
+    pub end_sample: u64,
+    pub indicators: Indicators,
+    /// In [`FaultKind::ALL`] order, each from its own band.
+    pub scores: &'a [FaultScore; 4],
+    pub bands: &'a [Band; 4],
+    /// Averaged amplitude spectrum of the band of the highest score.
+    pub spectrum: &'a [f32],
+    pub spectrum_band: Band,
+    pub bin_hz: f64,
+    pub windows_averaged: usize,
+}
+
+/// What the monitor tells its driver.
+pub enum MonitorEvent<'a> {
+    Window(WindowReport<'a>),
+    Flag {
+        fault: FaultKind,
+        change: FlagChange,
+        score: f64,
+        frequency_hz: f64,
+    },
+    Stage(StageChange),
+    Sensor {
+        condition: SensorCondition,
+        active: bool,
+        at_sample: u64,
+    },
+    Bands {
+        at_sample: u64,
+        bands: [Band; 4],
+        selected: Band,
+    },
+    /// Samples were missing: the windows restart after the gap.
+    Gap {
+        at_sample: u64,
+        missing: u64,
+    },
+}
+
+/// The streaming analysis of one channel.
+pub struct ChannelMonitor {
+    settings: MonitorSettings,
+    freqs: FaultFrequencies,
+    rolling: RollingEnvelope,
+    scorer: FaultScorer,
+    flags: [FaultFlag; 4],
+    health: HealthTracker,
+    scores: [FaultScore; 4],
+    bands: [Band; 4],
+    bands_known: bool,
+    /// The last `band_history_samples` samples, for band re-selection.
+    history: Vec<f32>,
+    history_at: usize,
+    history_filled: usize,
+    next_band_selection: u64,
+    next_sample: u64,
+    scratch: Vec<f32>,
+    clipping: bool,
+    last_clip: u64,
+    flat: bool,
+    flat_since: u64,
+    last_count: Option<i32>,
+    analyzer: RecordAnalyzer,
+}
+
+/// Samples converted per chunk (the scratch buffer's size).
+const CHUNK: usize = 4096;
+
+impl ChannelMonitor {
+    pub fn new(
+        settings: MonitorSettings,
+        freqs: FaultFrequencies,
+        baseline: Option<Baseline>,
+    ) -> Self {
+        let window = window_samples(settings.analysis.window_s, settings.fs_hz);
+        let hop = super::envelope::hop_samples(window, settings.analysis.overlap);
+        let bin_hz = settings.fs_hz / window as f64;
+        let bins =
+            ((envelope_range_hz(&freqs, settings.analysis.harmonics) / bin_hz).ceil() as usize + 1)
+                .min(window / 2);
+        let whole = Band::new(0.0, settings.fs_hz / 2.0);
+        let mut scorer = FaultScorer::new(
+            settings.analysis.fault_tolerance,
+            settings.analysis.harmonics,
+            bins,
+        );
+        let scores = scorer.score_all(&[], bin_hz, &freqs);
+        ChannelMonitor {
+            rolling: RollingEnvelope::new(
+                settings.fs_hz,
+                window,
+                hop,
+                settings.analysis.averages,
+                &[whole; 4],
+                bins,
+            ),
+            scorer,
+            flags: std::array::from_fn(|_| FaultFlag::new(settings.flags)),
+            health: HealthTracker::new(settings.baseline_windows, settings.sigma, 3, baseline),
+            scores,
+            bands: [whole; 4],
+            bands_known: false,
+            history: vec![0.0; settings.band_history_samples.max(window)],
+            history_at: 0,
+            history_filled: 0,
+            next_band_selection: settings.band_history_samples.max(window) as u64,
+            next_sample: 0,
+            scratch: vec![0.0; CHUNK],
+            clipping: false,
+            last_clip: 0,
+            flat: false,
+            flat_since: 0,
+            last_count: None,
+            analyzer: RecordAnalyzer::default(),
+            freqs,
+            settings,
+        }
+    }
+
+    pub fn frequencies(&self) -> &FaultFrequencies {
+        &self.freqs
+    }
+
+    /// A new shaft speed (from a speed frame or an estimate): fault frequencies follow.
+    pub fn set_frequencies(&mut self, freqs: FaultFrequencies) {
+        self.freqs = freqs;
+    }
+
+    pub fn bands(&self) -> Option<&[Band; 4]> {
+        self.bands_known.then_some(&self.bands)
+    }
+
+    pub fn flag_levels(&self) -> [super::flags::FlagLevel; 4] {
+        self.flags.each_ref().map(|f| f.level())
+    }
+
+    pub fn health(&self) -> &HealthTracker {
+        &self.health
+    }
+
+    pub fn next_sample(&self) -> u64 {
+        self.next_sample
+    }
+
+    /// The newest `len` samples, oldest first (for the twin's re-fit).
+    pub fn recent_samples(&self, len: usize) -> Vec<f32> {
+        let len = len.min(self.history_filled);
+        let n = self.history.len();
+        (0..len)
+            .map(|i| self.history[(self.history_at + n - len + i) % n])
+            .collect()
+    }
+
+    /// Feeds a block of integer counts starting at sample `first_sample`, scaled by
+    /// `scale_g_per_count`. A block that does not start where the last one ended is a gap: it
+    /// is reported and the windows restart, never bridged.
+    pub fn push_counts(
+        &mut self,
+        first_sample: u64,
+        counts: &[i16],
+        scale_g_per_count: f64,
+        on_event: &mut impl FnMut(MonitorEvent),
+    ) {
+        if first_sample != self.next_sample {
+            if first_sample > self.next_sample {
+                on_event(MonitorEvent::Gap {
+                    at_sample: self.next_sample,
+                    missing: first_sample - self.next_sample,
+                });
+            }
+            self.rolling.restart_at(first_sample);
+            self.history_filled = 0;
+            self.next_sample = first_sample;
+            self.last_count = None;
+        }
+        for chunk in counts.chunks(CHUNK) {
+            self.check_sensor(chunk, on_event);
+            let mut scratch = std::mem::take(&mut self.scratch);
+            for (s, &c) in scratch.iter_mut().zip(chunk) {
+                *s = (f64::from(c) * scale_g_per_count) as f32;
+            }
+            self.push_samples(&scratch[..chunk.len()], on_event);
+            self.scratch = scratch;
+        }
+    }
+
+    /// Cuts `samples` at the scheduled band selections, so that a selection happens at the same
+    /// sample whatever the block sizes.
+    fn push_samples(&mut self, mut samples: &[f32], on_event: &mut impl FnMut(MonitorEvent)) {
+        while !samples.is_empty() {
+            let until_selection = self.next_band_selection.saturating_sub(self.next_sample);
+            let take = if until_selection == 0 {
+                samples.len()
+            } else {
+                samples.len().min(until_selection as usize)
+            };
+            self.analyse(&samples[..take], on_event);
+            samples = &samples[take..];
+            if self.next_sample >= self.next_band_selection {
+                if self.history_filled == self.history.len() {
+                    self.select_bands(on_event);
+                }
+                self.next_band_selection =
+                    self.next_sample + self.settings.band_period_samples.max(1);
+            }
+        }
+    }
+
+    fn analyse(&mut self, samples: &[f32], on_event: &mut impl FnMut(MonitorEvent)) {
+        // Keep the history for band selection.
+        let n = self.history.len();
+        for &x in samples {
+            self.history[self.history_at] = x;
+            self.history_at = (self.history_at + 1) % n;
+        }
+        self.history_filled = (self.history_filled + samples.len()).min(n);
+        self.next_sample += samples.len() as u64;
+
+        let ChannelMonitor {
+            rolling,
+            scorer,
+            flags,
+            health,
+            scores,
+            bands,
+            bands_known,
+            freqs,
+            ..
+        } = self;
+        rolling.push(samples, |update| {
+            let indicators =
+                Indicators::of_slices(&[update.window_samples.0, update.window_samples.1]);
+            for (i, kind) in FaultKind::ALL.iter().enumerate() {
+                scores[i] = scorer.score(
+                    update.bands[i].averaged_amplitude(),
+                    update.bin_hz,
+                    *kind,
+                    freqs,
+                );
+            }
+            if let Some(change) =
+                health.update(indicators.kurtosis, indicators.rms, update.end_sample)
+            {
+                on_event(MonitorEvent::Stage(change));
+            }
+            if *bands_known {
+                for (i, kind) in FaultKind::ALL.iter().enumerate() {
+                    if let Some(change) = flags[i].update(scores[i].score, update.end_sample) {
+                        on_event(MonitorEvent::Flag {
+                            fault: *kind,
+                            change,
+                            score: scores[i].score,
+                            frequency_hz: scores[i].frequency_hz,
+                        });
+                    }
+                }
+            }
+            let top = (0..4)
+                .max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))
+                .unwrap_or(0);
+            on_event(MonitorEvent::Window(WindowReport {
+                end_sample: update.end_sample,
+                indicators,
+                scores,
+                bands,
+                spectrum: update.bands[top].averaged_amplitude(),
+                spectrum_band: update.bands[top].band(),
+                bin_hz: update.bin_hz,
+                windows_averaged: update.windows_averaged,
+            }));
+        });
+    }
+
+    /// Runs the whole-record analysis over the history and follows its bands.
+    fn select_bands(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
+        let n = self.history.len();
+        let contiguous: Vec<f32> = (0..n)
+            .map(|i| self.history[(self.history_at + i) % n])
+            .collect();
+        let Ok(analysis) = self.analyzer.analyze(
+            &contiguous,
+            self.settings.fs_hz,
+            &self.freqs,
+            &self.settings.analysis,
+        ) else {
+            return;
+        };
+        let band_of = |kind: FaultKind| {
+            analysis
+                .hypotheses
+                .iter()
+                .find(|h| h.score.fault == kind)
+                .map_or(analysis.selected_band(), |h| {
+                    analysis.scan.bands[h.band_index].band
+                })
+        };
+        let bands = FaultKind::ALL.map(band_of);
+        if !self.bands_known || bands != self.bands {
+            self.rolling.set_bands(&bands);
+            self.bands = bands;
+        }
+        self.bands_known = true;
+        on_event(MonitorEvent::Bands {
+            at_sample: self.next_sample,
+            bands,
+            selected: analysis.selected_band(),
+        });
+    }
+
+    /// Clipping starts at the first count at full scale and ends after a quiet stretch as long
+    /// as the flat-line length; a flat line starts once the count has not changed for that
+    /// long. Both are judged sample by sample, so block boundaries do not matter.
+    fn check_sensor(&mut self, counts: &[i16], on_event: &mut impl FnMut(MonitorEvent)) {
+        let at = self.next_sample;
+        for (i, &c) in counts.iter().enumerate() {
+            let sample = at + i as u64;
+            let c = i32::from(c);
+            if c.abs() >= self.settings.clip_count {
+                self.last_clip = sample;
+                if !self.clipping {
+                    self.clipping = true;
+                    on_event(MonitorEvent::Sensor {
+                        condition: SensorCondition::Clipping,
+                        active: true,
+                        at_sample: sample,
+                    });
+                }
+            } else if self.clipping && sample - self.last_clip >= self.settings.flat_line_samples {
+                self.clipping = false;
+                on_event(MonitorEvent::Sensor {
+                    condition: SensorCondition::Clipping,
+                    active: false,
+                    at_sample: sample,
+                });
+            }
+            if self.last_count != Some(c) {
+                self.flat_since = sample;
+                self.last_count = Some(c);
+                if self.flat {
+                    self.flat = false;
+                    on_event(MonitorEvent::Sensor {
+                        condition: SensorCondition::FlatLine,
+                        active: false,
+                        at_sample: sample,
+                    });
+                }
+            } else if !self.flat && sample + 1 - self.flat_since >= self.settings.flat_line_samples
+            {
+                self.flat = true;
+                on_event(MonitorEvent::Sensor {
+                    condition: SensorCondition::FlatLine,
+                    active: true,
+                    at_sample: sample,
+                });
+            }
+        }
+    }
+}

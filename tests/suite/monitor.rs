@@ -1,0 +1,175 @@
+//! The streaming analysis of one channel: a simulated bearing that develops an outer-race fault
+//! raises exactly that flag, after the onset, and the same samples cut into other blocks give
+//! exactly the same events at the same samples.
+
+use bearingd::analysis::flags::{FlagLevel, FlagSettings};
+use bearingd::analysis::health::HealthStage;
+use bearingd::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
+use bearingd::analysis::AnalysisSettings;
+use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
+
+const SCALE: f64 = 0.000_488;
+
+fn settings(fs: f64) -> MonitorSettings {
+    MonitorSettings {
+        fs_hz: fs,
+        analysis: AnalysisSettings::default(),
+        band_period_samples: (20.0 * fs) as u64,
+        band_history_samples: (10.0 * fs) as usize,
+        flags: FlagSettings {
+            watch_score: 10.0,
+            alarm_score: 15.0,
+            clear_ratio: 0.8,
+            on_delay_samples: (5.0 * fs) as u64,
+            off_delay_samples: (30.0 * fs) as u64,
+        },
+        baseline_windows: 20,
+        sigma: 3.0,
+        clip_count: 32_767,
+        flat_line_samples: fs as u64,
+    }
+}
+
+fn counts(seconds: f64, onset_s: f64) -> (Vec<i16>, SimulationParams) {
+    let params = SimulationParams {
+        onset_s,
+        ramp_s: 10.0,
+        noise_g: 0.2,
+        ..SimulationParams::example(SimulatedFault::OuterRace)
+    };
+    let g = Simulator::record(params.clone(), seconds);
+    (
+        g.iter()
+            .map(|&x| (f64::from(x) / SCALE).round().clamp(-32_768.0, 32_767.0) as i16)
+            .collect(),
+        params,
+    )
+}
+
+/// Events as comparable text lines.
+fn run(counts: &[i16], params: &SimulationParams, block: usize) -> Vec<String> {
+    let mut monitor = ChannelMonitor::new(settings(params.fs_hz), params.frequencies(), None);
+    let mut events = Vec::new();
+    let mut at = 0;
+    for chunk in counts.chunks(block) {
+        monitor.push_counts(at as u64, chunk, SCALE, &mut |event| match event {
+            MonitorEvent::Flag {
+                fault,
+                change,
+                score,
+                ..
+            } => events.push(format!(
+                "flag {} {:?}->{:?} at {} score {score:.3}",
+                fault.name(),
+                change.from,
+                change.to,
+                change.at_sample
+            )),
+            MonitorEvent::Stage(change) => {
+                events.push(format!("stage {:?} at {}", change.to, change.at_sample))
+            }
+            MonitorEvent::Bands {
+                at_sample, bands, ..
+            } => events.push(format!("bands at {at_sample}: {bands:?}")),
+            MonitorEvent::Sensor {
+                condition,
+                active,
+                at_sample,
+            } => events.push(format!(
+                "sensor {} {active} at {at_sample}",
+                condition.name()
+            )),
+            MonitorEvent::Gap { at_sample, missing } => {
+                events.push(format!("gap {missing} at {at_sample}"))
+            }
+            MonitorEvent::Window(_) => {}
+        });
+        at += chunk.len();
+    }
+    events
+}
+
+#[test]
+fn a_developing_outer_race_fault_raises_its_flag_after_onset_and_nothing_else() {
+    let (counts, params) = counts(100.0, 30.0);
+    let events = run(&counts, &params, 1_000);
+    let onset_sample = (30.0 * params.fs_hz) as u64;
+    let flags: Vec<&String> = events.iter().filter(|e| e.starts_with("flag")).collect();
+    assert!(!flags.is_empty(), "no flag raised: {events:#?}");
+    for flag in &flags {
+        assert!(
+            flag.starts_with("flag outer_race"),
+            "a flag other than outer race: {flag}\n{events:#?}"
+        );
+        let at: u64 = flag
+            .split(" at ")
+            .nth(1)
+            .unwrap()
+            .split(' ')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(at > onset_sample, "flag before the onset: {flag}");
+    }
+    assert!(flags.iter().any(|f| f.contains("->Alarm")), "{flags:#?}");
+    assert!(
+        events
+            .iter()
+            .any(|e| e == &format!("stage {:?} at {}", HealthStage::Healthy, 0))
+            || events.iter().any(|e| e.starts_with("stage Healthy"))
+    );
+    assert!(
+        events.iter().any(|e| e.starts_with("stage Degrading")),
+        "{events:#?}"
+    );
+}
+
+#[test]
+fn the_same_samples_in_other_blocks_give_the_same_events() {
+    let (counts, params) = counts(70.0, 20.0);
+    let reference = run(&counts, &params, 4_096);
+    assert!(
+        reference.iter().any(|e| e.starts_with("flag")),
+        "{reference:#?}"
+    );
+    for block in [1_000, 333, 12_000] {
+        assert_eq!(
+            run(&counts, &params, block),
+            reference,
+            "block size {block}"
+        );
+    }
+}
+
+#[test]
+fn gaps_are_reported_and_never_bridged_and_a_flat_line_is_seen() {
+    let (mut counts, params) = counts(30.0, 100.0);
+    let fs = params.fs_hz as usize;
+    counts[12 * fs..14 * fs].fill(123);
+    let mut monitor = ChannelMonitor::new(settings(params.fs_hz), params.frequencies(), None);
+    let mut gaps = Vec::new();
+    let mut flat = Vec::new();
+    let mut last_end = 0;
+    monitor.push_counts(0, &counts[..10 * fs], SCALE, &mut |_| {});
+    // 0.5 s lost.
+    monitor.push_counts(
+        (10 * fs + fs / 2) as u64,
+        &counts[10 * fs + fs / 2..],
+        SCALE,
+        &mut |event| match event {
+            MonitorEvent::Gap { at_sample, missing } => gaps.push((at_sample, missing)),
+            MonitorEvent::Sensor {
+                active, at_sample, ..
+            } => flat.push((active, at_sample)),
+            MonitorEvent::Window(w) => last_end = w.end_sample,
+            _ => {}
+        },
+    );
+    assert_eq!(gaps, vec![((10 * fs) as u64, (fs / 2) as u64)]);
+    assert!(last_end > (14 * fs) as u64, "windows go on after the gap");
+    assert_eq!(flat.len(), 2, "{flat:?}");
+    assert!(flat[0].0 && !flat[1].0);
+    assert_eq!(flat[1].1, (14 * fs) as u64);
+    assert_eq!(monitor.flag_levels(), [FlagLevel::Ok; 4]);
+}
