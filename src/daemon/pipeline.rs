@@ -1,0 +1,418 @@
+//! The analysis stage of the daemon, shared by `run` and `replay`: inputs in sample time
+//! (sample blocks and sensor events, whatever their source) → one [`ChannelMonitor`] per
+//! channel → messages for the sinks, and requests for the twin's re-fit.
+//!
+//! Synchronous and single-threaded on purpose: it runs on its own thread in `run` and in
+//! `replay` alike, and its outputs depend only on its inputs, so a replay of the logged raw
+//! samples gives the same flags at the same samples.
+
+use super::messages::{
+    ChannelId, FlagMessage, HealthMessage, IndicatorsMessage, PipelineMessage, RawBlock,
+    SpectrumMessage,
+};
+use crate::analysis::flags::{FlagLevel, FlagSettings};
+use crate::analysis::health::{Baseline, HealthStage};
+use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
+use crate::analysis::{Band, FaultKind};
+use crate::bearing::FaultFrequencies;
+use crate::config::{Config, SensorConfig};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// What the pipeline consumes.
+#[derive(Debug, Clone)]
+pub enum Input {
+    /// Consecutive integer counts of one channel starting at `first_sample`.
+    Samples {
+        channel: ChannelId,
+        first_sample: u64,
+        scale_g_per_count: f64,
+        counts: Vec<i16>,
+    },
+    /// The source has not heard the sensor for longer than its timeout, or hears it again.
+    SensorLost {
+        sensor: String,
+    },
+    SensorBack {
+        sensor: String,
+    },
+    /// The sensor (node) restarted: its sample positions start again.
+    Restart {
+        channel: ChannelId,
+        first_sample: u64,
+    },
+}
+
+/// A request for the twin's re-fit, handed to the re-fit thread.
+#[derive(Debug, Clone)]
+pub struct TwinRequest {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    pub fs_hz: f64,
+    pub freqs: FaultFrequencies,
+    /// Bands of the outer-race, inner-race and ball hypotheses.
+    pub bands: [Band; 3],
+    pub samples: Vec<f32>,
+}
+
+/// What the pipeline produces.
+#[derive(Debug, Clone)]
+pub enum Output {
+    Message(PipelineMessage),
+    Twin(TwinRequest),
+}
+
+/// The latest state of a channel, for status lines and the exit summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct ChannelStatus {
+    pub channel: ChannelId,
+    pub rpm: f64,
+    pub samples: u64,
+    pub seconds: f64,
+    pub band_hz: Option<[f64; 2]>,
+    pub top_fault: Option<FaultKind>,
+    pub top_score: f64,
+    pub flags: [FlagLevel; 4],
+    pub stage: HealthStage,
+    pub gaps: u64,
+    pub missing_samples: u64,
+    pub twin_hypothesis: Option<String>,
+    pub twin_error: Option<f64>,
+    pub sensor_lost: bool,
+    pub flag_changes: u64,
+}
+
+struct Channel {
+    monitor: ChannelMonitor,
+    fs_hz: f64,
+    status: ChannelStatus,
+    next_spectrum: u64,
+    next_twin: u64,
+}
+
+/// The analysis stage.
+pub struct Pipeline {
+    channels: BTreeMap<ChannelId, Channel>,
+    spectrum_every_samples: f64,
+    twin_period_s: f64,
+    twin_window_s: f64,
+}
+
+/// The monitor settings of one sensor: the config's durations turned into samples.
+pub fn monitor_settings(config: &Config, sensor: &SensorConfig) -> MonitorSettings {
+    let fs = sensor.sample_rate_hz;
+    let t = &config.thresholds;
+    let samples = |seconds: f64| (seconds * fs).round().max(0.0) as u64;
+    MonitorSettings {
+        fs_hz: fs,
+        analysis: config.analysis.clone(),
+        band_period_samples: samples(config.band_period_s),
+        band_history_samples: samples(BAND_HISTORY_S) as usize,
+        flags: FlagSettings {
+            watch_score: t.watch_score,
+            alarm_score: t.alarm_score,
+            clear_ratio: t.clear_ratio,
+            on_delay_samples: samples(t.on_delay_s),
+            off_delay_samples: samples(t.off_delay_s),
+        },
+        baseline_windows: t.baseline_windows as u64,
+        sigma: t.sigma,
+        clip_count: i32::from(i16::MAX),
+        flat_line_samples: samples(1.0),
+    }
+}
+
+/// Seconds of signal a band re-selection analyses.
+pub const BAND_HISTORY_S: f64 = 10.0;
+
+impl Pipeline {
+    /// One monitor per (sensor, axis); `baselines` resumes health stages kept across restarts.
+    pub fn new(config: &Config, baselines: &BTreeMap<ChannelId, Baseline>) -> Self {
+        let mut channels = BTreeMap::new();
+        for sensor in &config.sensors {
+            let freqs = sensor.bearing.fault_frequencies(sensor.speed.shaft_hz());
+            for axis in &sensor.axes {
+                let id = ChannelId {
+                    sensor: sensor.id.clone(),
+                    axis: axis.clone(),
+                };
+                let monitor = ChannelMonitor::new(
+                    monitor_settings(config, sensor),
+                    freqs,
+                    baselines.get(&id).cloned(),
+                );
+                let status = ChannelStatus {
+                    channel: id.clone(),
+                    rpm: sensor.speed.shaft_hz() * 60.0,
+                    samples: 0,
+                    seconds: 0.0,
+                    band_hz: None,
+                    top_fault: None,
+                    top_score: 0.0,
+                    flags: [FlagLevel::Ok; 4],
+                    stage: monitor.health().stage(),
+                    gaps: 0,
+                    missing_samples: 0,
+                    twin_hypothesis: None,
+                    twin_error: None,
+                    sensor_lost: false,
+                    flag_changes: 0,
+                };
+                let fs_hz = sensor.sample_rate_hz;
+                channels.insert(
+                    id,
+                    Channel {
+                        monitor,
+                        fs_hz,
+                        status,
+                        next_spectrum: 0,
+                        next_twin: (BAND_HISTORY_S * fs_hz) as u64,
+                    },
+                );
+            }
+        }
+        Pipeline {
+            channels,
+            spectrum_every_samples: 1.0,
+            twin_period_s: config.twin.refit_period_s,
+            twin_window_s: config.twin.window_s,
+        }
+    }
+
+    pub fn channels(&self) -> impl Iterator<Item = &ChannelId> {
+        self.channels.keys()
+    }
+
+    pub fn status(&self) -> Vec<ChannelStatus> {
+        self.channels.values().map(|c| c.status.clone()).collect()
+    }
+
+    pub fn baselines(&self) -> BTreeMap<ChannelId, Baseline> {
+        self.channels
+            .iter()
+            .map(|(id, c)| (id.clone(), c.monitor.health().baseline().clone()))
+            .collect()
+    }
+
+    /// Records the twin's latest result in the channel's status.
+    pub fn note_twin(&mut self, channel: &ChannelId, hypothesis: &str, error: f64) {
+        if let Some(c) = self.channels.get_mut(channel) {
+            c.status.twin_hypothesis = Some(hypothesis.to_string());
+            c.status.twin_error = Some(error);
+        }
+    }
+
+    /// Handles one input; unknown channels are reported, not analysed.
+    pub fn handle(&mut self, input: Input, out: &mut impl FnMut(Output)) {
+        match input {
+            Input::Samples {
+                channel,
+                first_sample,
+                scale_g_per_count,
+                counts,
+            } => {
+                let spectrum_every_samples = self.spectrum_every_samples;
+                let (twin_period_s, twin_window_s) = (self.twin_period_s, self.twin_window_s);
+                let Some(c) = self.channels.get_mut(&channel) else {
+                    return;
+                };
+                out(Output::Message(PipelineMessage::Raw(RawBlock {
+                    channel: channel.clone(),
+                    first_sample,
+                    sample_rate_hz: c.fs_hz,
+                    scale_g_per_count,
+                    counts: counts.iter().map(|&c| i32::from(c)).collect(),
+                })));
+                let fs = c.fs_hz;
+                let Channel {
+                    monitor,
+                    status,
+                    next_spectrum,
+                    ..
+                } = c;
+                monitor.push_counts(first_sample, &counts, scale_g_per_count, &mut |event| {
+                    handle_event(
+                        &channel,
+                        fs,
+                        spectrum_every_samples,
+                        next_spectrum,
+                        status,
+                        event,
+                        out,
+                    )
+                });
+                c.status.samples = c.monitor.next_sample();
+                c.status.seconds = c.status.samples as f64 / fs;
+                c.status.flags = c.monitor.flag_levels();
+                c.status.stage = c.monitor.health().stage();
+                if let Some(bands) = c.monitor.bands() {
+                    if c.monitor.next_sample() >= c.next_twin {
+                        c.next_twin = c.monitor.next_sample() + (twin_period_s * fs) as u64;
+                        out(Output::Twin(TwinRequest {
+                            channel: channel.clone(),
+                            end_sample: c.monitor.next_sample(),
+                            fs_hz: fs,
+                            freqs: *c.monitor.frequencies(),
+                            bands: [bands[0], bands[1], bands[2]],
+                            samples: c.monitor.recent_samples((twin_window_s * fs) as usize),
+                        }));
+                    }
+                }
+            }
+            Input::SensorLost { sensor } => self.sensor_event(&sensor, true, out),
+            Input::SensorBack { sensor } => self.sensor_event(&sensor, false, out),
+            Input::Restart {
+                channel,
+                first_sample,
+            } => {
+                if let Some(c) = self.channels.get(&channel) {
+                    out(Output::Message(PipelineMessage::Health(HealthMessage {
+                        channel: channel.clone(),
+                        end_sample: c.monitor.next_sample(),
+                        kind: "restart".into(),
+                        stage: None,
+                        detail: format!(
+                            "the sensor node restarted; its samples start again at {first_sample}"
+                        ),
+                    })));
+                }
+            }
+        }
+    }
+
+    fn sensor_event(&mut self, sensor: &str, lost: bool, out: &mut impl FnMut(Output)) {
+        for (id, c) in self
+            .channels
+            .iter_mut()
+            .filter(|(id, _)| id.sensor == sensor)
+        {
+            c.status.sensor_lost = lost;
+            out(Output::Message(PipelineMessage::Health(HealthMessage {
+                channel: id.clone(),
+                end_sample: c.monitor.next_sample(),
+                kind: if lost { "lost".into() } else { "back".into() },
+                stage: None,
+                detail: if lost {
+                    "no frame from the sensor within its timeout".into()
+                } else {
+                    "the sensor sends again".into()
+                },
+            })));
+        }
+    }
+}
+
+fn handle_event(
+    channel: &ChannelId,
+    fs: f64,
+    spectrum_every_s: f64,
+    next_spectrum: &mut u64,
+    status: &mut ChannelStatus,
+    event: MonitorEvent,
+    out: &mut impl FnMut(Output),
+) {
+    let message = match event {
+        MonitorEvent::Window(w) => {
+            let top = (0..4)
+                .max_by(|&a, &b| w.scores[a].score.total_cmp(&w.scores[b].score))
+                .unwrap_or(0);
+            status.top_fault = Some(FaultKind::ALL[top]);
+            status.top_score = w.scores[top].score;
+            status.band_hz = Some([w.bands[top].lo_hz, w.bands[top].hi_hz]);
+            if w.end_sample >= *next_spectrum {
+                *next_spectrum = w.end_sample + (spectrum_every_s * fs) as u64;
+                out(Output::Message(PipelineMessage::Spectrum(
+                    SpectrumMessage {
+                        channel: channel.clone(),
+                        end_sample: w.end_sample,
+                        band_hz: [w.spectrum_band.lo_hz, w.spectrum_band.hi_hz],
+                        bin_hz: w.bin_hz,
+                        windows_averaged: w.windows_averaged,
+                        amplitude: w.spectrum.to_vec(),
+                    },
+                )));
+            }
+            PipelineMessage::Indicators(IndicatorsMessage {
+                channel: channel.clone(),
+                end_sample: w.end_sample,
+                rpm: status.rpm,
+                band_hz: [w.bands[top].lo_hz, w.bands[top].hi_hz],
+                rms: w.indicators.rms,
+                peak: w.indicators.peak,
+                crest: w.indicators.crest,
+                kurtosis: w.indicators.kurtosis,
+                score_outer_race: w.scores[0].score,
+                score_inner_race: w.scores[1].score,
+                score_ball: w.scores[2].score,
+                score_cage: w.scores[3].score,
+            })
+        }
+        MonitorEvent::Flag {
+            fault,
+            change,
+            score,
+            frequency_hz,
+        } => {
+            status.flag_changes += 1;
+            PipelineMessage::Flag(FlagMessage {
+                channel: channel.clone(),
+                end_sample: change.at_sample,
+                fault: fault.name().into(),
+                from: change.from.name().into(),
+                to: change.to.name().into(),
+                score,
+                fault_frequency_hz: frequency_hz,
+            })
+        }
+        MonitorEvent::Stage(change) => PipelineMessage::Health(HealthMessage {
+            channel: channel.clone(),
+            end_sample: change.at_sample,
+            kind: "stage".into(),
+            stage: Some(change.to.name().into()),
+            detail: format!("health stage {} → {}", change.from.name(), change.to.name()),
+        }),
+        MonitorEvent::Sensor {
+            condition,
+            active,
+            at_sample,
+        } => PipelineMessage::Health(HealthMessage {
+            channel: channel.clone(),
+            end_sample: at_sample,
+            kind: condition.name().into(),
+            stage: None,
+            detail: if active {
+                format!("{} started", condition.name())
+            } else {
+                format!("{} ended", condition.name())
+            },
+        }),
+        MonitorEvent::Gap { at_sample, missing } => {
+            status.gaps += 1;
+            status.missing_samples += missing;
+            PipelineMessage::Health(HealthMessage {
+                channel: channel.clone(),
+                end_sample: at_sample,
+                kind: "gap".into(),
+                stage: None,
+                detail: format!(
+                    "{missing} samples missing; the analysis windows restart after the gap"
+                ),
+            })
+        }
+        MonitorEvent::Bands {
+            at_sample,
+            bands,
+            selected,
+        } => PipelineMessage::Health(HealthMessage {
+            channel: channel.clone(),
+            end_sample: at_sample,
+            kind: "bands".into(),
+            stage: None,
+            detail: format!(
+                "bands re-selected: outer {} inner {} ball {} cage {} (method's choice {})",
+                bands[0], bands[1], bands[2], bands[3], selected
+            ),
+        }),
+    };
+    out(Output::Message(message));
+}

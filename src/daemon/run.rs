@@ -1,0 +1,378 @@
+//! `bearingd run`: sources → the analysis thread → the sink thread, with the twin's re-fits on
+//! their own thread and status on the async side.
+//!
+//! Threads and queues (every queue bounded, its policy declared):
+//! - async (tokio): sources, signals, status lines. Sources send into the analysis queue and
+//!   wait when it is full (`Block`): an in-process source is simply slowed; a transport source
+//!   then backs up into its own buffer, where a loss shows as an exact sequence gap.
+//! - analysis thread: the [`Pipeline`]; hands messages to the sink queue (`Block`) and twin
+//!   requests to the re-fit queue (`DropNewest`: a request that finds the re-fit thread busy is
+//!   skipped and counted; the next period brings a fresh one).
+//! - re-fit thread: [`TwinWorker`]; its results go to the sink queue.
+//! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
+//!   them at shutdown happens there.
+
+use super::messages::{ChannelId, FlagMessage, PipelineMessage};
+use super::pipeline::{ChannelStatus, Input, Output, Pipeline, TwinRequest};
+use super::sim_source::SimSource;
+use super::twin_worker::TwinWorker;
+use crate::analysis::health::Baseline;
+use crate::config::{Config, Transport};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::{mpsc, Arc, Mutex};
+
+/// How `run` should behave beyond the config.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Stop after this much sample time (seconds); `None`: until a signal.
+    pub duration_s: Option<f64>,
+    /// Pace simulated sensors at real time (`true`) or as fast as the analysis allows.
+    pub realtime: bool,
+    /// Print a status line per channel every `status_interval_s`.
+    pub status_lines: bool,
+}
+
+/// Why `run` could not start or had to stop.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("sensor '{sensor}': transport '{transport}' is not available in `bearingd run` of this build; use transport = \"sim\" or the ingest command for now")]
+    TransportUnavailable {
+        sensor: String,
+        transport: &'static str,
+    },
+    #[error("{path}: cannot create the directory: {source}; check its permissions or set outputs.state_dir / outputs.mcap_dir")]
+    Directory {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{what} thread failed: {detail}")]
+    Thread { what: &'static str, detail: String },
+}
+
+/// What a run did, for the summary on exit.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RunSummary {
+    pub channels: Vec<ChannelStatus>,
+    pub flags: Vec<FlagMessage>,
+    pub messages: u64,
+    pub twin_fits: u64,
+    pub twin_requests_skipped: u64,
+}
+
+/// A consumer of pipeline messages on the sink thread.
+pub trait Sink: Send {
+    fn write(&mut self, message: &PipelineMessage);
+    /// Flush and close; called once at shutdown.
+    fn finish(&mut self) -> Result<(), String>;
+}
+
+const ANALYSIS_QUEUE: usize = 64;
+const SINK_QUEUE: usize = 1024;
+/// Length of a simulated sensor's block, in seconds of sample time.
+const SIM_BLOCK_S: f64 = 0.1;
+
+/// Runs until `shutdown` resolves or the duration is reached.
+pub async fn run(
+    config: Config,
+    options: RunOptions,
+    mut sinks: Vec<Box<dyn Sink>>,
+    shutdown: impl std::future::Future<Output = ()>,
+) -> Result<RunSummary, RunError> {
+    let mut sims = Vec::new();
+    for sensor in &config.sensors {
+        match &sensor.transport {
+            Transport::Sim(sim) => sims.push(SimSource::new(sensor, sim, SIM_BLOCK_S)),
+            Transport::Can(_) => {
+                return Err(RunError::TransportUnavailable {
+                    sensor: sensor.id.clone(),
+                    transport: "can",
+                })
+            }
+            Transport::Shm(_) => {
+                return Err(RunError::TransportUnavailable {
+                    sensor: sensor.id.clone(),
+                    transport: "shm",
+                })
+            }
+        }
+    }
+    let state_dir = config.outputs.state_dir.clone();
+    std::fs::create_dir_all(&state_dir).map_err(|source| RunError::Directory {
+        path: state_dir.clone(),
+        source,
+    })?;
+    let baselines = load_baselines(&state_dir);
+    let pipeline = Pipeline::new(&config, &baselines);
+    let status_board = Arc::new(Mutex::new(pipeline.status()));
+    let twin_board: Arc<Mutex<BTreeMap<ChannelId, (String, f64)>>> = Arc::default();
+    let skipped = Arc::new(AtomicU64::new(0));
+
+    let (input_tx, mut input_rx) = tokio::sync::mpsc::channel::<Input>(ANALYSIS_QUEUE);
+    let (sink_tx, sink_rx) = mpsc::sync_channel::<PipelineMessage>(SINK_QUEUE);
+    let (twin_tx, twin_rx) = mpsc::sync_channel::<TwinRequest>(1);
+
+    // The analysis thread.
+    let analysis = {
+        let sink_tx = sink_tx.clone();
+        let status_board = status_board.clone();
+        let twin_board = twin_board.clone();
+        let skipped = skipped.clone();
+        let state_dir = state_dir.clone();
+        std::thread::Builder::new()
+            .name("bearingd-analysis".into())
+            .spawn(move || {
+                let mut pipeline = pipeline;
+                while let Some(input) = input_rx.blocking_recv() {
+                    pipeline.handle(input, &mut |output| match output {
+                        Output::Message(m) => {
+                            let _ = sink_tx.send(m);
+                        }
+                        Output::Twin(request) => {
+                            if twin_tx.try_send(request).is_err() {
+                                skipped.fetch_add(1, Ordering::Relaxed);
+                            }
+                        }
+                    });
+                    if let Ok(twins) = twin_board.lock() {
+                        for (channel, (hypothesis, error)) in twins.iter() {
+                            pipeline.note_twin(channel, hypothesis, *error);
+                        }
+                    }
+                    if let Ok(mut board) = status_board.lock() {
+                        *board = pipeline.status();
+                    }
+                }
+                save_baselines(&state_dir, &pipeline.baselines());
+            })
+            .map_err(|e| RunError::Thread {
+                what: "analysis",
+                detail: e.to_string(),
+            })?
+    };
+    // The twin's re-fit thread.
+    let refit = {
+        let sink_tx = sink_tx.clone();
+        let twin_board = twin_board.clone();
+        std::thread::Builder::new()
+            .name("bearingd-twin".into())
+            .spawn(move || {
+                let mut worker = TwinWorker::default();
+                let mut fits = 0u64;
+                while let Ok(request) = twin_rx.recv() {
+                    if let Some(message) = worker.refit(&request) {
+                        if let Ok(mut board) = twin_board.lock() {
+                            board.insert(
+                                message.channel.clone(),
+                                (message.hypothesis.clone(), message.error),
+                            );
+                        }
+                        fits += 1;
+                        let _ = sink_tx.send(PipelineMessage::Twin(message));
+                    }
+                }
+                fits
+            })
+            .map_err(|e| RunError::Thread {
+                what: "twin re-fit",
+                detail: e.to_string(),
+            })?
+    };
+    drop(sink_tx);
+    // The sink thread.
+    let sink = std::thread::Builder::new()
+        .name("bearingd-sink".into())
+        .spawn(move || {
+            let mut flags = Vec::new();
+            let mut messages = 0u64;
+            let mut errors = Vec::new();
+            while let Ok(message) = sink_rx.recv() {
+                messages += 1;
+                if let PipelineMessage::Flag(flag) = &message {
+                    flags.push(flag.clone());
+                }
+                for sink in sinks.iter_mut() {
+                    sink.write(&message);
+                }
+            }
+            for sink in sinks.iter_mut() {
+                if let Err(e) = sink.finish() {
+                    errors.push(e);
+                }
+            }
+            (flags, messages, errors)
+        })
+        .map_err(|e| RunError::Thread {
+            what: "sink",
+            detail: e.to_string(),
+        })?;
+
+    // Sources and status on the async side.
+    let feed = feed_simulated(sims, input_tx, options.clone());
+    let status = print_status(
+        status_board.clone(),
+        config.outputs.status_interval_s,
+        options.status_lines,
+    );
+    tokio::select! {
+        _ = feed => {},
+        _ = shutdown => {},
+        _ = status => {},
+    }
+    // Dropping the sources' sender (inside `feed`) ends the analysis thread, which ends the
+    // re-fit thread, which ends the sink thread.
+    analysis.join().map_err(|_| RunError::Thread {
+        what: "analysis",
+        detail: "panicked".into(),
+    })?;
+    let twin_fits = refit.join().map_err(|_| RunError::Thread {
+        what: "twin re-fit",
+        detail: "panicked".into(),
+    })?;
+    let (flags, messages, errors) = sink.join().map_err(|_| RunError::Thread {
+        what: "sink",
+        detail: "panicked".into(),
+    })?;
+    if let Some(error) = errors.into_iter().next() {
+        return Err(RunError::Thread {
+            what: "sink",
+            detail: error,
+        });
+    }
+    let channels = status_board.lock().map(|b| b.clone()).unwrap_or_default();
+    Ok(RunSummary {
+        channels,
+        flags,
+        messages,
+        twin_fits,
+        twin_requests_skipped: skipped.load(Ordering::Relaxed),
+    })
+}
+
+/// Feeds the simulated sensors' blocks, paced at real time or as fast as the queue takes them.
+async fn feed_simulated(
+    mut sims: Vec<SimSource>,
+    tx: tokio::sync::mpsc::Sender<Input>,
+    options: RunOptions,
+) {
+    let mut ticker = tokio::time::interval(std::time::Duration::from_secs_f64(SIM_BLOCK_S));
+    ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    loop {
+        if options.realtime {
+            ticker.tick().await;
+        }
+        for sim in sims.iter_mut() {
+            for input in sim.next_blocks() {
+                if tx.send(input).await.is_err() {
+                    return;
+                }
+            }
+        }
+        let done = options.duration_s.is_some_and(|d| {
+            sims.iter()
+                .all(|s| s.next_sample() as f64 >= d * sim_rate(s))
+        });
+        if done || sims.is_empty() {
+            return;
+        }
+        if !options.realtime {
+            tokio::task::yield_now().await;
+        }
+    }
+}
+
+fn sim_rate(sim: &SimSource) -> f64 {
+    sim.sample_rate_hz()
+}
+
+/// A status line per channel every `interval_s` (never resolves).
+async fn print_status(board: Arc<Mutex<Vec<ChannelStatus>>>, interval_s: f64, enabled: bool) {
+    if !enabled {
+        return std::future::pending().await;
+    }
+    let mut ticker = tokio::time::interval(std::time::Duration::from_secs_f64(interval_s.max(0.1)));
+    ticker.tick().await;
+    loop {
+        ticker.tick().await;
+        let lines: Vec<String> = board
+            .lock()
+            .map(|b| b.iter().map(status_line).collect())
+            .unwrap_or_default();
+        for line in lines {
+            println!("{line}");
+        }
+    }
+}
+
+/// One channel's status in one line.
+pub fn status_line(s: &ChannelStatus) -> String {
+    let band = s.band_hz.map_or("learning".to_string(), |b| {
+        format!("{:.0}-{:.0} Hz", b[0], b[1])
+    });
+    let top = s.top_fault.map_or("-".to_string(), |f| {
+        format!("{} {:.1}", f.name(), s.top_score)
+    });
+    let twin = match (&s.twin_hypothesis, s.twin_error) {
+        (Some(h), Some(e)) => format!("{h} err {e:.3}"),
+        _ => "-".into(),
+    };
+    let flags: Vec<String> = crate::analysis::FaultKind::ALL
+        .iter()
+        .zip(&s.flags)
+        .filter(|(_, l)| l.name() != "ok")
+        .map(|(k, l)| format!("{}={}", k.name(), l.name()))
+        .collect();
+    format!(
+        "{} t={:.1}s rpm={:.0} band={} top={} twin={} stage={} flags={}{}",
+        s.channel,
+        s.seconds,
+        s.rpm,
+        band,
+        top,
+        twin,
+        s.stage.name(),
+        if flags.is_empty() {
+            "ok".to_string()
+        } else {
+            flags.join(",")
+        },
+        if s.sensor_lost { " SENSOR LOST" } else { "" }
+    )
+}
+
+const BASELINES_FILE: &str = "baselines.json";
+
+/// Health baselines kept across restarts; a missing or unreadable file starts afresh (and says so).
+pub fn load_baselines(state_dir: &Path) -> BTreeMap<ChannelId, Baseline> {
+    let path = state_dir.join(BASELINES_FILE);
+    let Ok(text) = std::fs::read_to_string(&path) else {
+        return BTreeMap::new();
+    };
+    match serde_json::from_str::<Vec<(ChannelId, Baseline)>>(&text) {
+        Ok(list) => list.into_iter().collect(),
+        Err(e) => {
+            eprintln!(
+                "bearingd: warning: {}: unreadable ({e}); health baselines are learned again",
+                path.display()
+            );
+            BTreeMap::new()
+        }
+    }
+}
+
+fn save_baselines(state_dir: &Path, baselines: &BTreeMap<ChannelId, Baseline>) {
+    let path = state_dir.join(BASELINES_FILE);
+    let temporary = state_dir.join(format!("{BASELINES_FILE}.new"));
+    let list: Vec<_> = baselines.iter().collect();
+    let written = serde_json::to_string_pretty(&list)
+        .map_err(std::io::Error::other)
+        .and_then(|text| std::fs::write(&temporary, text))
+        .and_then(|_| std::fs::rename(&temporary, &path));
+    if let Err(e) = written {
+        eprintln!(
+            "bearingd: warning: {}: cannot save the health baselines: {e}",
+            path.display()
+        );
+    }
+}
