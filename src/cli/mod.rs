@@ -7,6 +7,7 @@
 
 mod analyze;
 mod config_cmd;
+mod ingest;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -54,6 +55,8 @@ enum Command {
         /// The TOML file to check.
         file: std::path::PathBuf,
     },
+    /// Run one source (SocketCAN or iceoryx2) alone and report what arrived.
+    Ingest(ingest::IngestArgs),
     /// Configuration helpers.
     Config {
         #[command(subcommand)]
@@ -68,6 +71,7 @@ pub fn main() -> ExitCode {
         Command::Analyze(args) => analyze::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
+        Command::Ingest(args) => ingest::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
