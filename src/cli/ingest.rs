@@ -67,6 +67,9 @@ pub struct IngestArgs {
     /// Expect exactly N restarts in total (one per restarted stream).
     #[arg(long, value_name = "N")]
     expect_restarts: Option<u64>,
+    /// Expect exactly N sensor-lost reports in total (a sender that stops is lost once).
+    #[arg(long, value_name = "N")]
+    expect_sensor_lost: Option<u64>,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -313,6 +316,11 @@ fn check_expectations(
             stats.malformed.total(),
         ),
         ("restarts", args.expect_restarts, stats.restarts),
+        (
+            "sensor-lost reports",
+            args.expect_sensor_lost,
+            stats.sensor_lost,
+        ),
     ];
     for (what, expected, got) in totals {
         if let Some(expected) = expected {

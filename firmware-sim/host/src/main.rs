@@ -21,7 +21,7 @@ use pacing::{BusPacer, SampleClock};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 use transport::Transport;
 
 /// Frames a simulated node can queue (the node drains it after every few samples).
@@ -331,7 +331,7 @@ fn open_transport(args: &Args) -> Result<Box<dyn Transport>, SimError> {
                 let shm =
                     transport::shm::ShmTransport::open(&args.sensor, &iox, !args.shm_discard)?;
                 if let Some(seconds) = args.wait_ready {
-                    shm.wait_ready(Duration::from_secs_f64(seconds.max(0.0)))?;
+                    shm.wait_ready(std::time::Duration::from_secs_f64(seconds.max(0.0)))?;
                 }
                 Ok(Box::new(shm))
             }
