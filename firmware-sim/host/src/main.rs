@@ -448,7 +448,9 @@ fn send_all(
                 let samples = data_samples(&bytes, fd);
                 *totals.on_wire.entry((cid.node, axis)).or_insert(0) += samples;
             }
-            if args.inject_malformed_every > 0 && totals.frames % args.inject_malformed_every == 0 {
+            if args.inject_malformed_every > 0
+                && totals.frames.is_multiple_of(args.inject_malformed_every)
+            {
                 let (bad_id, bad_bytes) = malformed(cid.node, totals.malformed);
                 pacer.wait_for_bus(bad_bytes.len(), false);
                 transport.send(bad_id, &bad_bytes, false)?;
