@@ -27,6 +27,9 @@ use transport::Transport;
 /// Frames a simulated node can queue (the node drains it after every few samples).
 const NODE_QUEUE: usize = 64;
 
+/// Shaft speed when neither `--rpm` nor the recording gives one (CWRU's 0 hp speed).
+const DEFAULT_RPM: f64 = 1772.0;
+
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
     #[error("CAN interface {interface}: {detail}")]
@@ -91,8 +94,9 @@ struct Args {
     /// Fault onset, s of sample time.
     #[arg(long, default_value_t = 0.0)]
     onset: f64,
-    #[arg(long, default_value_t = 1772.0)]
-    rpm: f64,
+    /// Shaft speed, rpm (twin, and the speed frames); default: the recording's own, else 1772.
+    #[arg(long)]
+    rpm: Option<f64>,
     /// White noise, g (standard deviation).
     #[arg(long, default_value_t = 0.05)]
     noise: f64,
@@ -184,7 +188,7 @@ fn run(args: &Args) -> Result<(), SimError> {
     if args.duration <= 0.0 {
         return Ok(());
     }
-    let (mut signal, fs) = open_signal(args)?;
+    let (mut signal, fs, rpm) = open_signal(args)?;
     let kind = if args.fd {
         FrameKind::Fd
     } else {
@@ -252,7 +256,7 @@ fn run(args: &Args) -> Result<(), SimError> {
         }
         for (k, node) in nodes.iter_mut().enumerate() {
             if send_speed {
-                let _ = node.push_speed(SpeedSource::Tachometer, Some((args.rpm * 100.0) as u32));
+                let _ = node.push_speed(SpeedSource::Tachometer, Some((rpm * 100.0) as u32));
             }
             for &axis in &axes {
                 let source = k * usize::from(args.axes) + usize::from(axis);
@@ -341,7 +345,8 @@ fn open_transport(args: &Args) -> Result<Box<dyn Transport>, SimError> {
     }
 }
 
-fn open_signal(args: &Args) -> Result<(Signal, u32), SimError> {
+/// The sample source, its sample rate (Hz) and the shaft speed (rpm) to report.
+fn open_signal(args: &Args) -> Result<(Signal, u32, f64), SimError> {
     if let Some(path) = &args.recording {
         let recording = read_recording(
             path,
@@ -361,12 +366,14 @@ fn open_signal(args: &Args) -> Result<(Signal, u32), SimError> {
                 )))
             }
         };
+        let rpm = args.rpm.or(recording.rpm).unwrap_or(DEFAULT_RPM);
         return Ok((
             Signal::Recording {
                 samples: recording.samples,
                 next: 0,
             },
             fs,
+            rpm,
         ));
     }
     let fs = args.fs.unwrap_or(25_600);
@@ -381,11 +388,12 @@ fn open_signal(args: &Args) -> Result<(Signal, u32), SimError> {
         FaultArg::Inner => SimulatedFault::InnerRace,
         FaultArg::Ball => SimulatedFault::Ball,
     };
+    let rpm = args.rpm.unwrap_or(DEFAULT_RPM);
     let streams = usize::from(args.nodes) * usize::from(args.axes);
     let simulators = (0..streams)
         .map(|i| {
             let mut params = SimulationParams::example(fault);
-            params.rpm = args.rpm;
+            params.rpm = rpm;
             params.fs_hz = f64::from(fs);
             params.noise_g = args.noise;
             params.onset_s = args.onset;
@@ -393,7 +401,7 @@ fn open_signal(args: &Args) -> Result<(Signal, u32), SimError> {
             Simulator::new(params)
         })
         .collect();
-    Ok((Signal::Twin(simulators), fs))
+    Ok((Signal::Twin(simulators), fs, rpm))
 }
 
 /// The next `out.len()` samples (g) of stream `source`, starting at sample `at`.
