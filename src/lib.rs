@@ -14,6 +14,8 @@
 //! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
 //! - [`twin`]: the signal-model twin of a defective bearing (simulation now, fitting later).
+//! - [`ingest`]: sources (SocketCAN, iceoryx2) that turn sensor frames into sample blocks in
+//!   sample time, counting gaps, restarts, silent sensors and malformed frames.
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
@@ -23,6 +25,7 @@ pub mod bearing;
 pub mod cli;
 pub mod config;
 pub mod daemon;
+pub mod ingest;
 pub mod offline;
 pub mod plot;
 pub mod recording;

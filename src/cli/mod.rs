@@ -7,6 +7,7 @@
 
 mod analyze;
 mod config_cmd;
+mod ingest;
 mod simulate;
 
 use clap::{Parser, Subcommand};
@@ -57,6 +58,8 @@ enum Command {
         /// The TOML file to check.
         file: std::path::PathBuf,
     },
+    /// Run one source (SocketCAN or iceoryx2) alone and report what arrived.
+    Ingest(ingest::IngestArgs),
     /// Configuration helpers.
     Config {
         #[command(subcommand)]
@@ -72,6 +75,7 @@ pub fn main() -> ExitCode {
         Command::Simulate(args) => simulate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
+        Command::Ingest(args) => ingest::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
