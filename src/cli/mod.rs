@@ -8,6 +8,7 @@
 mod analyze;
 mod config_cmd;
 mod ingest;
+mod run;
 mod simulate;
 
 use clap::{Parser, Subcommand};
@@ -51,6 +52,9 @@ struct Cli {
 enum Command {
     /// Diagnose a recording (CWRU .mat, PRONOSTIA/IMS/plain CSV, WAV) or the built-in demo.
     Analyze(analyze::AnalyzeArgs),
+    /// Run the service: sources → analysis → logs and alerts. Without --config, the embedded
+    /// default: a simulated sensor that develops an outer-race fault after 30 s.
+    Run(run::RunArgs),
     /// Write a synthetic record of a bearing fault (the twin's signal model) as CSV or WAV.
     Simulate(simulate::SimulateArgs),
     /// Check a configuration file; lists every problem with its key and how to fix it.
@@ -72,6 +76,7 @@ pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Analyze(args) => analyze::run(&args),
+        Command::Run(args) => run::run_command(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),

@@ -238,7 +238,7 @@ impl Default for OutputConfig {
 }
 
 /// Defaults of `[analysis]` keys that [`AnalysisSettings`] does not hold.
-pub(crate) const DEFAULT_BAND_PERIOD_S: f64 = 60.0;
+pub(crate) const DEFAULT_BAND_PERIOD_S: f64 = 20.0;
 /// Defaults of sensor keys.
 pub(crate) const DEFAULT_SCALE_G_PER_COUNT: f64 = 0.000488;
 pub(crate) const DEFAULT_AXIS: &str = "radial";

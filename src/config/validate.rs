@@ -943,7 +943,7 @@ impl Checker {
             &raw.band_period_s,
             DEFAULT_BAND_PERIOD_S,
             Limits::above_to(0.0, DAY_S),
-            "give how often the band is chosen again, in seconds, e.g. band_period_s = 60.0",
+            "give how often the band is chosen again, in seconds, e.g. band_period_s = 20.0",
         );
         let min_band_hz = self.min_band(&raw.min_band_hz, sensors);
         let fault_tolerance = self.number(

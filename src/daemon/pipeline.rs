@@ -245,6 +245,9 @@ impl Pipeline {
                 c.status.seconds = c.status.samples as f64 / fs;
                 c.status.flags = c.monitor.flag_levels();
                 c.status.stage = c.monitor.health().stage();
+                if c.monitor.bands().is_none() {
+                    c.status.band_hz = None;
+                }
                 if let Some(bands) = c.monitor.bands() {
                     if c.monitor.next_sample() >= c.next_twin {
                         c.next_twin = c.monitor.next_sample() + (twin_period_s * fs) as u64;
