@@ -4,9 +4,11 @@
 //! reading stopped and how many bytes were lost, to read a file that is still truncated, and to
 //! hold at most one chunk in memory. So this walks the top-level records itself (opcode, length,
 //! body: the MCAP framing), checks every length against what is left of the file and a hard
-//! limit before allocating, and hands each chunk to the crate's `ChunkReader`, which
-//! decompresses it and checks its CRC. A chunk is taken whole or not at all: its records are
-//! collected first and released only if the whole chunk decoded.
+//! limit before allocating, decompresses each chunk itself with the output bounded by the
+//! declared size, checks the chunk's CRC, and only then parses the records in it with
+//! `mcap::parse_record`. (The crate's `ChunkReader` trusts inner record lengths before the CRC
+//! is checked and can be made to allocate without bound by a flipped byte.) A chunk is taken
+//! whole or not at all.
 //!
 //! A chunk that fails (bad CRC, bad compression) but whose framing is intact is skipped and
 //! counted; a record whose framing is broken (a length past the end of the file: the open chunk
@@ -23,10 +25,14 @@ use super::error::{io_err, McapLogError, Result};
 
 /// No record or chunk larger than this is ever read into memory (the logger writes chunks of a
 /// few MiB; anything larger is corruption).
-pub const MAX_RECORD_BYTES: u64 = 256 * 1024 * 1024;
+pub const MAX_RECORD_BYTES: u64 = 64 * 1024 * 1024;
 
 const OP_DATA_END: u8 = 0x0F;
 const OP_FOOTER: u8 = 0x02;
+const OP_SCHEMA: u8 = 0x03;
+const OP_CHANNEL: u8 = 0x04;
+const OP_MESSAGE: u8 = 0x05;
+const OP_CHUNK: u8 = 0x06;
 
 /// A schema, channel or message read from a file, owned.
 #[derive(Debug, Clone)]
@@ -212,48 +218,36 @@ impl Scanner {
         if self.in_summary {
             return Ok(());
         }
-        match mcap::parse_record(opcode, &body) {
-            Ok(Record::Chunk { header, data }) => {
-                if header.uncompressed_size > MAX_RECORD_BYTES {
-                    self.skip_chunk(start, len, "chunk claims an oversize uncompressed length");
-                    return Ok(());
-                }
-                let reader = match mcap::read::ChunkReader::new(header, &data) {
-                    Ok(r) => r,
-                    Err(e) => {
-                        self.skip_chunk(start, len, &format!("chunk: {e}"));
-                        return Ok(());
-                    }
-                };
-                let mut records = Vec::new();
-                for record in reader {
-                    match record {
-                        Ok(record) => {
-                            if let Some(r) = own(record, start) {
-                                records.push(r);
+        match opcode {
+            OP_CHUNK => match decode_chunk(&body) {
+                Ok(records) => {
+                    for (op, rec) in records {
+                        match own(op, &rec, start) {
+                            Ok(Some(r)) => self.pending.push_back(r),
+                            Ok(None) => {}
+                            Err(e) => {
+                                self.pending.clear();
+                                self.skip_chunk(start, len, &e);
+                                return Ok(());
                             }
                         }
-                        Err(e) => {
-                            self.skip_chunk(start, len, &format!("chunk: {e}"));
-                            return Ok(());
-                        }
                     }
                 }
-                self.pending.extend(records);
-            }
-            Ok(record) => {
-                if let Some(r) = own(record, start) {
-                    self.pending.push_back(r);
+                Err(reason) => self.skip_chunk(start, len, &reason),
+            },
+            OP_SCHEMA | OP_CHANNEL | OP_MESSAGE => match own(opcode, &body, start) {
+                Ok(Some(r)) => self.pending.push_back(r),
+                Ok(None) => {}
+                Err(e) => {
+                    // Framing held (the length fit) but the body is not a valid record: skip it.
+                    self.outcome.unreadable_bytes += 9 + len;
+                    if self.outcome.first_problem.is_none() {
+                        self.outcome.first_problem = Some((start, e));
+                    }
                 }
-            }
-            Err(e) => {
-                // Framing held (the length fit) but the body is not a valid record: skip it.
-                self.outcome.unreadable_bytes += 9 + len;
-                if self.outcome.first_problem.is_none() {
-                    self.outcome.first_problem =
-                        Some((start, format!("record (opcode {opcode:#04x}): {e}")));
-                }
-            }
+            },
+            // Indexes, statistics, attachments, metadata: not needed to read messages in order.
+            _ => {}
         }
         Ok(())
     }
@@ -267,8 +261,14 @@ impl Scanner {
     }
 }
 
-fn own(record: Record<'_>, offset: u64) -> Option<ScannedRecord> {
-    match record {
+/// Parses one schema, channel or message record body; other opcodes give `Ok(None)`.
+fn own(opcode: u8, body: &[u8], offset: u64) -> std::result::Result<Option<ScannedRecord>, String> {
+    if !matches!(opcode, OP_SCHEMA | OP_CHANNEL | OP_MESSAGE) {
+        return Ok(None);
+    }
+    let record = mcap::parse_record(opcode, body)
+        .map_err(|e| format!("record (opcode {opcode:#04x}): {e}"))?;
+    Ok(match record {
         Record::Schema { header, data } => Some(ScannedRecord::Schema {
             id: header.id,
             name: header.name,
@@ -291,7 +291,105 @@ fn own(record: Record<'_>, offset: u64) -> Option<ScannedRecord> {
             offset,
         }),
         _ => None,
+    })
+}
+
+fn le_u32(b: &[u8], at: usize) -> Option<u32> {
+    Some(u32::from_le_bytes(
+        b.get(at..at.checked_add(4)?)?.try_into().ok()?,
+    ))
+}
+
+fn le_u64(b: &[u8], at: usize) -> Option<u64> {
+    Some(u64::from_le_bytes(
+        b.get(at..at.checked_add(8)?)?.try_into().ok()?,
+    ))
+}
+
+/// Decompresses a chunk record's body, checks its CRC and splits it into (opcode, body)
+/// records, all before anything is released: a chunk is taken whole or not at all. Every
+/// length is checked against the bytes at hand; the output never grows past the declared
+/// uncompressed size (itself at most [`MAX_RECORD_BYTES`]).
+///
+/// Layout (MCAP spec): message_start_time u64, message_end_time u64, uncompressed_size u64,
+/// uncompressed_crc u32, compression (u32 length + bytes), compressed_size u64, records.
+fn decode_chunk(body: &[u8]) -> std::result::Result<Vec<(u8, Vec<u8>)>, String> {
+    let bad = |what: &str| format!("chunk: {what}");
+    let uncompressed_size = le_u64(body, 16).ok_or_else(|| bad("header cut off"))?;
+    let crc = le_u32(body, 24).ok_or_else(|| bad("header cut off"))?;
+    let name_len = le_u32(body, 28).ok_or_else(|| bad("header cut off"))? as usize;
+    let name_end = 32usize
+        .checked_add(name_len)
+        .ok_or_else(|| bad("compression name length"))?;
+    let name = body
+        .get(32..name_end)
+        .ok_or_else(|| bad("compression name runs past the record"))?;
+    let compressed_size = le_u64(body, name_end).ok_or_else(|| bad("header cut off"))?;
+    let data_start = name_end + 8;
+    let available = (body.len() - data_start.min(body.len())) as u64;
+    if compressed_size > available {
+        return Err(bad(&format!(
+            "compressed size {compressed_size} > {available} bytes in the record"
+        )));
     }
+    if uncompressed_size > MAX_RECORD_BYTES {
+        return Err(bad(&format!(
+            "uncompressed size {uncompressed_size} over the limit"
+        )));
+    }
+    let data = &body[data_start..data_start + compressed_size as usize];
+    let limit = uncompressed_size + 1;
+    let mut out = Vec::new();
+    match name {
+        b"" => out.extend_from_slice(data),
+        b"zstd" => {
+            let decoder =
+                zstd::stream::read::Decoder::new(data).map_err(|e| bad(&format!("zstd: {e}")))?;
+            decoder
+                .take(limit)
+                .read_to_end(&mut out)
+                .map_err(|e| bad(&format!("zstd: {e}")))?;
+        }
+        b"lz4" => {
+            let decoder = lz4::Decoder::new(data).map_err(|e| bad(&format!("lz4: {e}")))?;
+            decoder
+                .take(limit)
+                .read_to_end(&mut out)
+                .map_err(|e| bad(&format!("lz4: {e}")))?;
+        }
+        other => {
+            return Err(bad(&format!(
+                "unsupported compression {:?}",
+                String::from_utf8_lossy(other)
+            )))
+        }
+    }
+    if out.len() as u64 != uncompressed_size {
+        return Err(bad(&format!(
+            "{} bytes decompressed, {uncompressed_size} declared",
+            out.len()
+        )));
+    }
+    if crc != 0 && crc32fast::hash(&out) != crc {
+        return Err(bad("CRC mismatch"));
+    }
+    let mut records = Vec::new();
+    let mut at = 0usize;
+    while at < out.len() {
+        let op = out[at];
+        let len =
+            le_u64(&out, at + 1).ok_or_else(|| bad("record header cut off inside the chunk"))?;
+        let start = at + 9;
+        if len > (out.len() - start) as u64 {
+            return Err(bad("record runs past the end of the chunk"));
+        }
+        let end = start + len as usize;
+        if matches!(op, OP_SCHEMA | OP_CHANNEL | OP_MESSAGE) {
+            records.push((op, out[start..end].to_vec()));
+        }
+        at = end;
+    }
+    Ok(records)
 }
 
 /// Error for a file that could not be scanned at all (used by callers that need one).
