@@ -6,12 +6,12 @@
 //! else 10 s of the twin's simulated outer-race fault (the same size).
 
 use bearingd::analysis::envelope::{FftPlans, RollingEnvelope};
+use bearingd::twin::diagnose::fit_record;
+use bearingd::twin::fit::{TwinFitter, HYPOTHESES};
 use bearingd::analysis::record::{analyze_record, RecordAnalyzer};
 use bearingd::analysis::{AnalysisSettings, Band, BandSelection};
 use bearingd::bearing::BearingGeometry;
 use bearingd::recording::{read_recording, ReadOptions};
-use bearingd::twin::diagnose::fit_record;
-use bearingd::twin::fit::{TwinFitter, HYPOTHESES};
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::hint::black_box;
@@ -103,22 +103,11 @@ fn rolling_update(c: &mut Criterion) {
 fn twin_refit(c: &mut Criterion) {
     let (signal, fs, rpm, name) = ten_second_record();
     let second = &signal[..fs as usize];
-    let freqs = BearingGeometry::from_catalog("skf-6205-2rs")
-        .unwrap()
-        .fault_frequencies(rpm / 60.0);
-    let settings = AnalysisSettings {
-        window_s: 4096.0 / fs,
-        ..AnalysisSettings::default()
-    };
-    let analysis = RecordAnalyzer::default()
-        .analyze(second, fs, &freqs, &settings)
-        .unwrap();
+    let freqs = BearingGeometry::from_catalog("skf-6205-2rs").unwrap().fault_frequencies(rpm / 60.0);
+    let settings = AnalysisSettings { window_s: 4096.0 / fs, ..AnalysisSettings::default() };
+    let analysis = RecordAnalyzer::default().analyze(second, fs, &freqs, &settings).unwrap();
     let band_of = |kind| {
-        let h = analysis
-            .hypotheses
-            .iter()
-            .find(|h| h.score.fault == kind)
-            .unwrap();
+        let h = analysis.hypotheses.iter().find(|h| h.score.fault == kind).unwrap();
         analysis.scan.bands[h.band_index].band
     };
     let bands = HYPOTHESES.map(band_of);
@@ -126,49 +115,11 @@ fn twin_refit(c: &mut Criterion) {
     let mut fitter = TwinFitter::default();
     let mut group = c.benchmark_group(format!("twin refit, 3 hypotheses, 1 s at 12 kHz ({name})"));
     group.bench_function("cold start", |b| {
-        b.iter(|| {
-            fit_record(
-                &mut plans,
-                &mut fitter,
-                black_box(second),
-                fs,
-                &freqs,
-                &bands,
-                4096,
-                0.5,
-                None,
-            )
-        })
+        b.iter(|| fit_record(&mut plans, &mut fitter, black_box(second), fs, &freqs, &bands, 4096, 0.5, None))
     });
-    let previous: Vec<_> = fit_record(
-        &mut plans,
-        &mut fitter,
-        second,
-        fs,
-        &freqs,
-        &bands,
-        4096,
-        0.5,
-        None,
-    )
-    .fits
-    .iter()
-    .map(|f| f.params)
-    .collect();
+    let previous: Vec<_> = fit_record(&mut plans, &mut fitter, second, fs, &freqs, &bands, 4096, 0.5, None).fits.iter().map(|f| f.params).collect();
     group.bench_function("warm start from the previous fit", |b| {
-        b.iter(|| {
-            fit_record(
-                &mut plans,
-                &mut fitter,
-                black_box(second),
-                fs,
-                &freqs,
-                &bands,
-                4096,
-                0.5,
-                Some(&previous),
-            )
-        })
+        b.iter(|| fit_record(&mut plans, &mut fitter, black_box(second), fs, &freqs, &bands, 4096, 0.5, Some(&previous)))
     });
     group.finish();
 }

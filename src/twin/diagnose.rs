@@ -178,9 +178,7 @@ fn time_residual(
     let (impact_phases, modulation_phases) = (24, if modulation_hz > 0.0 { 8 } else { 1 });
     // q² on a table of angles: the inner loop then needs no trigonometry.
     const ANGLES: usize = 360;
-    let load_table: Vec<f64> = (0..ANGLES)
-        .map(|i| stribeck_load(std::f64::consts::TAU * i as f64 / ANGLES as f64, 0.5, 1.5).powi(2))
-        .collect();
+    let load_table: Vec<f64> = (0..ANGLES).map(|i| stribeck_load(std::f64::consts::TAU * i as f64 / ANGLES as f64, 0.5, 1.5).powi(2)).collect();
     let p = &fit.params;
     let mut ratios = Vec::new();
     let mut twin = vec![0f64; band.analytic_len()];
@@ -215,11 +213,8 @@ fn time_residual(
                         if t_k > now {
                             break;
                         }
-                        let turns =
-                            (theta0 / std::f64::consts::TAU + modulation_hz * t_k).rem_euclid(1.0);
-                        let weight = p.a
-                            * p.a
-                            * load_table[((turns * ANGLES as f64) as usize).min(ANGLES - 1)];
+                        let turns = (theta0 / std::f64::consts::TAU + modulation_hz * t_k).rem_euclid(1.0);
+                        let weight = p.a * p.a * load_table[((turns * ANGLES as f64) as usize).min(ANGLES - 1)];
                         // The impact falls between two samples: decay it to this sample.
                         level += weight * (-2.0 * p.decay_per_s * (now - t_k)).exp();
                         next_impact += 1;
