@@ -13,6 +13,8 @@
 //! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
 //! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
+//! - [`mcap_log`]: the MCAP log: chunked, compressed files with a decodable schema per topic,
+//!   rotation and a disk budget, crash recovery, and the reader that replay uses.
 //! - [`twin`]: the signal-model twin of a defective bearing (simulation now, fitting later).
 //! - [`ingest`]: sources (SocketCAN, iceoryx2) that turn sensor frames into sample blocks in
 //!   sample time, counting gaps, restarts, silent sensors and malformed frames.
@@ -26,6 +28,7 @@ pub mod cli;
 pub mod config;
 pub mod daemon;
 pub mod ingest;
+pub mod mcap_log;
 pub mod offline;
 pub mod plot;
 pub mod recording;

@@ -1,0 +1,598 @@
+//! [`McapLogger`]: the daemon's MCAP sink.
+//!
+//! Blocking by design (file I/O and zstd): the daemon runs it on its own thread behind a bounded
+//! queue. One file at a time is open; it is chunked and zstd-compressed, and the daemon calls
+//! [`McapLogger::flush`] periodically (about every second of data) so that a crash loses at
+//! most the open chunk. Files rotate by size and by log-time duration; each is finished cleanly
+//! (summary and indexes, so strict readers open it); after each rotation the oldest finished
+//! files are deleted until the directory fits the disk budget.
+//!
+//! Time: the logger never reads a clock. The caller passes the opening time and every
+//! message's `log_time`/`publish_time` (nanoseconds since the Unix epoch; the daemon maps sample
+//! time to wall time). [`wall_clock_now_ns`] is the one helper that reads the system clock, for
+//! the daemon's edge only, so that tests stay deterministic.
+
+use std::collections::{BTreeMap, HashMap};
+use std::fs::{File, OpenOptions};
+use std::io::{self, BufWriter, Seek, SeekFrom, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+
+use mcap::records::MessageHeader;
+use mcap::{Compression, WriteOptions};
+
+use super::error::{io_err, McapLogError, Result};
+use super::schema::{self, JsonKind, RawBlockPb, RAW_BLOCK_SCHEMA};
+use crate::daemon::messages::PipelineMessage;
+
+/// File name prefix of every log file; retention only ever touches `bearingd-*.mcap`.
+pub const FILE_PREFIX: &str = "bearingd-";
+/// File name suffix.
+pub const FILE_SUFFIX: &str = ".mcap";
+
+/// Where and how to log.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoggerConfig {
+    /// Directory of the log files (created if missing).
+    pub dir: PathBuf,
+    /// Target uncompressed chunk size in bytes: a chunk is closed when it grows past this (and at
+    /// every [`McapLogger::flush`]).
+    pub chunk_size: u64,
+    /// Rotate once the open file reaches this many bytes (checked before each message, so a file
+    /// overshoots by at most one message plus the compressor's pending output).
+    pub max_file_bytes: u64,
+    /// Rotate once a message's log time is this far past the file's first message.
+    pub max_file_duration_ns: u64,
+    /// Total bytes of `bearingd-*.mcap` files the directory may hold; the oldest finished files
+    /// are deleted after each rotation to stay within it. The open file is never deleted.
+    pub disk_budget_bytes: u64,
+    /// zstd level (1..=19); 3 is zstd's default and keeps up easily on an edge CPU.
+    pub zstd_level: u32,
+}
+
+impl LoggerConfig {
+    /// Defaults for a directory: 4 MiB chunks, 256 MiB or 1 h files, 8 GiB budget, zstd 3.
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        LoggerConfig {
+            dir: dir.into(),
+            chunk_size: 4 * 1024 * 1024,
+            max_file_bytes: 256 * 1024 * 1024,
+            max_file_duration_ns: 3600 * 1_000_000_000,
+            disk_budget_bytes: 8 * 1024 * 1024 * 1024,
+            zstd_level: 3,
+        }
+    }
+
+    fn check(&self) -> Result<()> {
+        let mut problems = Vec::new();
+        if self.chunk_size == 0 {
+            problems.push("chunk_size must be > 0");
+        }
+        if self.max_file_bytes == 0 {
+            problems.push("max_file_bytes must be > 0");
+        }
+        if self.max_file_duration_ns == 0 {
+            problems.push("max_file_duration_ns must be > 0");
+        }
+        if self.disk_budget_bytes < self.max_file_bytes {
+            problems.push("disk_budget_bytes must be at least max_file_bytes");
+        }
+        if !(1..=19).contains(&self.zstd_level) {
+            problems.push("zstd_level must be within 1..=19");
+        }
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(McapLogError::Config(problems.join("; ")))
+        }
+    }
+}
+
+/// What was written to one topic (payload bytes: before MCAP framing and compression).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct TopicStats {
+    pub messages: u64,
+    pub payload_bytes: u64,
+}
+
+/// Counters of a logger's life.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct LogStats {
+    pub topics: BTreeMap<String, TopicStats>,
+    pub files_opened: u64,
+    pub files_finished: u64,
+    /// Bytes of the files this logger finished (final sizes).
+    pub finished_file_bytes: u64,
+    pub flushes: u64,
+    pub files_deleted: u64,
+    pub bytes_deleted: u64,
+}
+
+impl LogStats {
+    pub fn messages(&self) -> u64 {
+        self.topics.values().map(|t| t.messages).sum()
+    }
+    pub fn payload_bytes(&self) -> u64 {
+        self.topics.values().map(|t| t.payload_bytes).sum()
+    }
+}
+
+/// What one retention pass did.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct RetentionReport {
+    pub deleted: Vec<PathBuf>,
+    pub bytes_deleted: u64,
+    /// Bytes of `bearingd-*.mcap` files left in the directory, the open file included.
+    pub total_bytes_after: u64,
+}
+
+/// The system clock in nanoseconds since the Unix epoch: the only place this module reads a
+/// clock, for the daemon to call at its edge (never from analysis or from the logger itself).
+pub fn wall_clock_now_ns() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
+        .unwrap_or(0)
+}
+
+/// `bearingd-YYYYMMDDTHHMMSSZ-NNNNNN.mcap` for a UTC time in ns since the epoch: fixed width,
+/// so sorting names sorts files by opening time, then sequence.
+pub fn file_name(opened_at_ns: u64, seq: u32) -> String {
+    let secs = opened_at_ns / 1_000_000_000;
+    let days = (secs / 86_400) as i64;
+    let rem = secs % 86_400;
+    let (y, m, d) = civil_from_days(days);
+    format!(
+        "{FILE_PREFIX}{y:04}{m:02}{d:02}T{:02}{:02}{:02}Z-{seq:06}{FILE_SUFFIX}",
+        rem / 3600,
+        (rem / 60) % 60,
+        rem % 60
+    )
+}
+
+/// Gregorian date of a day count since 1970-01-01 (the well-known era/day-of-era method).
+fn civil_from_days(z: i64) -> (i64, u32, u32) {
+    let z = z + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097);
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let y = yoe + era * 400 + i64::from(m <= 2);
+    (y, m, d)
+}
+
+/// Is this a log file name this module wrote (and so may delete)?
+pub fn is_log_file_name(name: &str) -> bool {
+    name.starts_with(FILE_PREFIX) && name.ends_with(FILE_SUFFIX)
+}
+
+/// Tracks the logical position and length of a seekable stream, so the open file's size is
+/// known without a syscall per message. `mcap::Writer` does not lend out its stream, so the
+/// length is shared through an atomic (the logger may move between threads).
+struct Counting<W> {
+    inner: W,
+    pos: u64,
+    len: Arc<AtomicU64>,
+}
+
+impl<W> Counting<W> {
+    fn note(&self) {
+        self.len.fetch_max(self.pos, Ordering::Relaxed);
+    }
+}
+
+impl<W: Write> Write for Counting<W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.pos += n as u64;
+        self.note();
+        Ok(n)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+impl<W: Seek> Seek for Counting<W> {
+    fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
+        self.pos = self.inner.seek(pos)?;
+        self.note();
+        Ok(self.pos)
+    }
+}
+
+type FileWriter = mcap::Writer<Counting<BufWriter<File>>>;
+
+struct OpenFile {
+    path: PathBuf,
+    writer: FileWriter,
+    len: Arc<AtomicU64>,
+    first_log_time: Option<u64>,
+    /// topic → (channel id, next sequence)
+    channels: HashMap<String, (u16, u32)>,
+    raw_schema: Option<u16>,
+    json_schemas: HashMap<JsonKind, u16>,
+}
+
+impl OpenFile {
+    fn bytes(&self) -> u64 {
+        self.len.load(Ordering::Relaxed)
+    }
+
+    fn create(dir: &Path, opened_at_ns: u64, seq: &mut u32, config: &LoggerConfig) -> Result<Self> {
+        // Never overwrite: a restart within the same second reuses a name, so bump the sequence.
+        let mut tries = 0;
+        let (path, file) = loop {
+            let path = dir.join(file_name(opened_at_ns, *seq));
+            *seq = seq.wrapping_add(1);
+            match OpenOptions::new().write(true).create_new(true).open(&path) {
+                Ok(f) => break (path, f),
+                Err(e) if e.kind() == io::ErrorKind::AlreadyExists && tries < 10_000 => tries += 1,
+                Err(e) => return Err(io_err(&path, "create")(e)),
+            }
+        };
+        let len = Arc::new(AtomicU64::new(0));
+        let stream = Counting {
+            inner: BufWriter::with_capacity(256 * 1024, file),
+            pos: 0,
+            len: Arc::clone(&len),
+        };
+        let writer = WriteOptions::new()
+            .profile("")
+            .library(concat!("bearingd ", env!("CARGO_PKG_VERSION")))
+            .compression(Some(Compression::Zstd))
+            .compression_level(config.zstd_level)
+            .chunk_size(Some(config.chunk_size))
+            .create(stream)
+            .map_err(|source| McapLogError::Write {
+                path: path.clone(),
+                source,
+            })?;
+        Ok(OpenFile {
+            path,
+            writer,
+            len,
+            first_log_time: None,
+            channels: HashMap::new(),
+            raw_schema: None,
+            json_schemas: HashMap::new(),
+        })
+    }
+
+    /// Writes the summary, flushes and fsyncs; returns the final size.
+    fn finish(mut self) -> Result<u64> {
+        let path = self.path.clone();
+        self.writer.finish().map_err(|source| McapLogError::Write {
+            path: path.clone(),
+            source,
+        })?;
+        let counting = self.writer.into_inner();
+        let file = counting
+            .inner
+            .into_inner()
+            .map_err(|e| io_err(&path, "flush")(e.into_error()))?;
+        file.sync_all().map_err(io_err(&path, "fsync"))?;
+        Ok(self.len.load(Ordering::Relaxed))
+    }
+
+    /// The channel of `topic`, registering its schema and channel on first use.
+    fn channel(&mut self, topic: &str, kind: Option<JsonKind>) -> Result<&mut (u16, u32)> {
+        if !self.channels.contains_key(topic) {
+            let werr = |path: &Path| {
+                let path = path.to_path_buf();
+                move |source| McapLogError::Write { path, source }
+            };
+            let (schema_id, encoding) = match kind {
+                None => {
+                    let id = match self.raw_schema {
+                        Some(id) => id,
+                        None => {
+                            let id = self
+                                .writer
+                                .add_schema(
+                                    RAW_BLOCK_SCHEMA,
+                                    "protobuf",
+                                    &schema::raw_block_descriptor_set(),
+                                )
+                                .map_err(werr(&self.path))?;
+                            self.raw_schema = Some(id);
+                            id
+                        }
+                    };
+                    (id, "protobuf")
+                }
+                Some(kind) => {
+                    let id = match self.json_schemas.get(&kind) {
+                        Some(&id) => id,
+                        None => {
+                            let data = kind.json_schema().to_string();
+                            let id = self
+                                .writer
+                                .add_schema(kind.schema_name(), "jsonschema", data.as_bytes())
+                                .map_err(werr(&self.path))?;
+                            self.json_schemas.insert(kind, id);
+                            id
+                        }
+                    };
+                    (id, "json")
+                }
+            };
+            let id = self
+                .writer
+                .add_channel(schema_id, topic, encoding, &BTreeMap::new())
+                .map_err(werr(&self.path))?;
+            self.channels.insert(topic.to_string(), (id, 0));
+        }
+        // Present: inserted above if it was missing.
+        self.channels
+            .get_mut(topic)
+            .ok_or_else(|| McapLogError::Config(format!("channel {topic} vanished")))
+    }
+}
+
+/// The MCAP log sink. See the module docs.
+pub struct McapLogger {
+    config: LoggerConfig,
+    open: Option<OpenFile>,
+    seq: u32,
+    stats: LogStats,
+    topic: String,
+    payload: Vec<u8>,
+}
+
+impl McapLogger {
+    /// Creates the directory if needed, applies the disk budget to what is already there and
+    /// opens the first file, named after `opened_at_ns` (ns since the Unix epoch, UTC).
+    ///
+    /// Run [`super::recover_directory`] before this at start-up: an unfinished file from a
+    /// crash is recovered there, not here.
+    pub fn create(config: LoggerConfig, opened_at_ns: u64) -> Result<Self> {
+        config.check()?;
+        std::fs::create_dir_all(&config.dir).map_err(io_err(&config.dir, "create directory"))?;
+        let mut logger = McapLogger {
+            config,
+            open: None,
+            seq: 0,
+            stats: LogStats::default(),
+            topic: String::with_capacity(64),
+            payload: Vec::with_capacity(64 * 1024),
+        };
+        logger.open_file(opened_at_ns)?;
+        logger.apply_retention()?;
+        Ok(logger)
+    }
+
+    fn open_file(&mut self, opened_at_ns: u64) -> Result<()> {
+        let file = OpenFile::create(&self.config.dir, opened_at_ns, &mut self.seq, &self.config)?;
+        self.open = Some(file);
+        self.stats.files_opened += 1;
+        Ok(())
+    }
+
+    /// The file being written.
+    pub fn current_path(&self) -> Option<&Path> {
+        self.open.as_ref().map(|f| f.path.as_path())
+    }
+
+    /// Bytes of the open file so far (what has left the compressor).
+    pub fn current_file_bytes(&self) -> u64 {
+        self.open.as_ref().map_or(0, OpenFile::bytes)
+    }
+
+    pub fn stats(&self) -> &LogStats {
+        &self.stats
+    }
+
+    pub fn config(&self) -> &LoggerConfig {
+        &self.config
+    }
+
+    /// Logs one pipeline message on its topic. `log_time_ns`/`publish_time_ns` are wall time in
+    /// ns since the epoch, mapped from sample time by the caller. Rotates first if the open file
+    /// is full or spans `max_file_duration_ns`; the new file is named after `log_time_ns`.
+    /// Returns the retention report of that rotation, if one happened.
+    pub fn log(
+        &mut self,
+        message: &PipelineMessage,
+        log_time_ns: u64,
+        publish_time_ns: u64,
+    ) -> Result<Option<RetentionReport>> {
+        let rotation = match &self.open {
+            Some(f) => {
+                let too_big = f.bytes() >= self.config.max_file_bytes;
+                let too_long = f.first_log_time.is_some_and(|t0| {
+                    log_time_ns.saturating_sub(t0) >= self.config.max_file_duration_ns
+                });
+                if too_big || too_long {
+                    Some(self.rotate(log_time_ns)?)
+                } else {
+                    None
+                }
+            }
+            None => {
+                self.open_file(log_time_ns)?;
+                None
+            }
+        };
+
+        self.topic.clear();
+        let kind = encode(message, &mut self.topic, &mut self.payload);
+        let Some(file) = self.open.as_mut() else {
+            return Err(McapLogError::Config("no open file".into()));
+        };
+        let entry = file.channel(&self.topic, kind)?;
+        let header = MessageHeader {
+            channel_id: entry.0,
+            sequence: entry.1,
+            log_time: log_time_ns,
+            publish_time: publish_time_ns,
+        };
+        entry.1 = entry.1.wrapping_add(1);
+        file.writer
+            .write_to_known_channel(&header, &self.payload)
+            .map_err(|source| McapLogError::Write {
+                path: file.path.clone(),
+                source,
+            })?;
+        file.first_log_time.get_or_insert(log_time_ns);
+        let bytes = self.payload.len() as u64;
+        match self.stats.topics.get_mut(&self.topic) {
+            Some(s) => {
+                s.messages += 1;
+                s.payload_bytes += bytes;
+            }
+            None => {
+                let s = TopicStats {
+                    messages: 1,
+                    payload_bytes: bytes,
+                };
+                self.stats.topics.insert(self.topic.clone(), s);
+            }
+        }
+        Ok(rotation)
+    }
+
+    /// Closes the open chunk and hands it to the OS, bounding what a crash can lose. (No fsync:
+    /// a process crash loses nothing that was flushed; a power loss is the file system's call.)
+    pub fn flush(&mut self) -> Result<()> {
+        if let Some(file) = self.open.as_mut() {
+            file.writer.flush().map_err(|source| McapLogError::Write {
+                path: file.path.clone(),
+                source,
+            })?;
+            self.stats.flushes += 1;
+        }
+        Ok(())
+    }
+
+    /// Finishes the open file, opens the next (named after `opened_at_ns`) and applies the disk
+    /// budget.
+    pub fn rotate(&mut self, opened_at_ns: u64) -> Result<RetentionReport> {
+        if let Some(file) = self.open.take() {
+            let bytes = file.finish()?;
+            self.stats.files_finished += 1;
+            self.stats.finished_file_bytes += bytes;
+        }
+        self.open_file(opened_at_ns)?;
+        self.apply_retention()
+    }
+
+    /// Deletes the oldest finished `bearingd-*.mcap` files (by name: opening time, then
+    /// sequence) until the directory's log files fit `disk_budget_bytes`. Never the open file.
+    pub fn apply_retention(&mut self) -> Result<RetentionReport> {
+        let open = self.open.as_ref().map(|f| f.path.clone());
+        let report = enforce_budget(
+            &self.config.dir,
+            self.config.disk_budget_bytes,
+            open.as_deref(),
+        )?;
+        self.stats.files_deleted += report.deleted.len() as u64;
+        self.stats.bytes_deleted += report.bytes_deleted;
+        Ok(report)
+    }
+
+    /// Finishes the open file (summary, index, fsync) and returns the counters.
+    pub fn finish(mut self) -> Result<LogStats> {
+        if let Some(file) = self.open.take() {
+            let bytes = file.finish()?;
+            self.stats.files_finished += 1;
+            self.stats.finished_file_bytes += bytes;
+        }
+        Ok(std::mem::take(&mut self.stats))
+    }
+}
+
+/// Retention over a directory: see [`McapLogger::apply_retention`].
+pub fn enforce_budget(dir: &Path, budget: u64, open: Option<&Path>) -> Result<RetentionReport> {
+    let mut files: Vec<(String, PathBuf, u64)> = Vec::new();
+    let entries = std::fs::read_dir(dir).map_err(io_err(dir, "list directory"))?;
+    for entry in entries {
+        let entry = entry.map_err(io_err(dir, "list directory"))?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !is_log_file_name(&name) {
+            continue;
+        }
+        let path = entry.path();
+        let len = match entry.metadata() {
+            Ok(m) if m.is_file() => m.len(),
+            Ok(_) => continue,
+            // Deleted meanwhile (another pass): nothing to count.
+            Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
+            Err(e) => return Err(io_err(&path, "stat")(e)),
+        };
+        files.push((name, path, len));
+    }
+    files.sort();
+    let mut total: u64 = files.iter().map(|f| f.2).sum();
+    let mut report = RetentionReport::default();
+    for (_, path, len) in &files {
+        if total <= budget {
+            break;
+        }
+        if open == Some(path.as_path()) {
+            continue;
+        }
+        match std::fs::remove_file(path) {
+            Ok(()) => {}
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+            Err(e) => return Err(io_err(path, "delete")(e)),
+        }
+        total -= len;
+        report.deleted.push(path.clone());
+        report.bytes_deleted += len;
+    }
+    report.total_bytes_after = total;
+    Ok(report)
+}
+
+/// Serializes `message` into `payload` and its topic into `topic`; returns the JSON kind, or
+/// `None` for raw (protobuf).
+fn encode(
+    message: &PipelineMessage,
+    topic: &mut String,
+    payload: &mut Vec<u8>,
+) -> Option<JsonKind> {
+    use std::fmt::Write as _;
+    payload.clear();
+    // Serializing these plain structs into a Vec cannot fail (no maps with non-string keys).
+    let (kind, r) = match message {
+        PipelineMessage::Raw(b) => {
+            let _ = write!(topic, "/raw/{}/{}", b.channel.sensor, b.channel.axis);
+            RawBlockPb::encode_block(b, payload);
+            return None;
+        }
+        PipelineMessage::Spectrum(m) => {
+            let _ = write!(topic, "/spectrum/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Spectrum, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Indicators(m) => {
+            let _ = write!(topic, "/indicators/{}/{}", m.channel.sensor, m.channel.axis);
+            (
+                JsonKind::Indicators,
+                serde_json::to_writer(&mut *payload, m),
+            )
+        }
+        PipelineMessage::Twin(m) => {
+            let _ = write!(topic, "/twin/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Twin, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Flag(m) => {
+            let _ = write!(topic, "/flags/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Flag, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Health(m) => {
+            let _ = write!(topic, "/health/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Health, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Ingest(m) => {
+            let _ = write!(topic, "/ingest/{}", m.source);
+            (JsonKind::Ingest, serde_json::to_writer(&mut *payload, m))
+        }
+    };
+    debug_assert!(r.is_ok());
+    Some(kind)
+}
