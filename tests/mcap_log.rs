@@ -8,7 +8,7 @@
 //! the Python half is skipped with a note.
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Stdio};
 
 use bearingd::daemon::messages::*;
@@ -19,49 +19,9 @@ use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 
 const T0: u64 = 1_795_000_000_000_000_000; // 2026-11-18, ns since the epoch
 
-fn python() -> Option<PathBuf> {
-    let py = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
-    let ci = std::env::var("CI").is_ok_and(|v| v == "true");
-    let problem = if !py.exists() {
-        Some(format!("{} does not exist", py.display()))
-    } else {
-        let out = Command::new(&py)
-            .args(["-c", "import mcap, mcap_protobuf, google.protobuf"])
-            .output()
-            .expect("run python");
-        (!out.status.success()).then(|| String::from_utf8_lossy(&out.stderr).into_owned())
-    };
-    match problem {
-        None => Some(py),
-        Some(p) if ci => panic!(
-            "Python MCAP reader missing ({p}); create it with `python3 -m venv .venv && \
-             .venv/bin/pip install -r scripts/requirements-ci.txt` (mcap, mcap-protobuf-support, protobuf)"
-        ),
-        Some(p) => {
-            eprintln!("skipping the Python check: {p}");
-            None
-        }
-    }
-}
-
-/// Runs `tests/python/check_mcap.py` on `file`; returns its JSON summary.
-fn python_check(py: &Path, file: &Path, expected: Option<&Path>) -> serde_json::Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/check_mcap.py");
-    let mut cmd = Command::new(py);
-    cmd.arg(script).arg(file);
-    if let Some(e) = expected {
-        cmd.arg(e);
-    }
-    let out = cmd.output().expect("run check_mcap.py");
-    assert!(
-        out.status.success(),
-        "check_mcap.py failed on {}:\n{}\n{}",
-        file.display(),
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).expect("summary JSON")
-}
+use bearingd::recording::testdata::{
+    check_mcap_with_python as python_check, python_mcap as python,
+};
 
 fn ch(sensor: &str, axis: &str) -> ChannelId {
     ChannelId {

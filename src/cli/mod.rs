@@ -8,6 +8,7 @@
 mod analyze;
 mod config_cmd;
 mod ingest;
+mod replay;
 mod run;
 mod simulate;
 
@@ -55,6 +56,8 @@ enum Command {
     /// Run the service: sources → analysis → logs and alerts. Without --config, the embedded
     /// default: a simulated sensor that develops an outer-race fault after 30 s.
     Run(run::RunArgs),
+    /// Replay MCAP logs' raw samples through the same pipeline, as fast as possible or at --speed.
+    Replay(replay::ReplayArgs),
     /// Write a synthetic record of a bearing fault (the twin's signal model) as CSV or WAV.
     Simulate(simulate::SimulateArgs),
     /// Check a configuration file; lists every problem with its key and how to fix it.
@@ -77,6 +80,7 @@ pub fn main() -> ExitCode {
     let result = match cli.command {
         Command::Analyze(args) => analyze::run(&args),
         Command::Run(args) => run::run_command(&args),
+        Command::Replay(args) => replay::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),

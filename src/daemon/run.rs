@@ -12,12 +12,14 @@
 //! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
 //!   them at shutdown happens there.
 
+use super::mcap_sink::McapSink;
 use super::messages::{ChannelId, FlagMessage, PipelineMessage};
 use super::pipeline::{ChannelStatus, Input, Output, Pipeline, TwinRequest};
 use super::sim_source::SimSource;
 use super::twin_worker::TwinWorker;
 use crate::analysis::health::Baseline;
 use crate::config::{Config, Transport};
+use crate::mcap_log::{wall_clock_now_ns, LoggerConfig};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -47,6 +49,8 @@ pub enum RunError {
         path: PathBuf,
         source: std::io::Error,
     },
+    #[error("MCAP log: {0}")]
+    Log(String),
     #[error("{what} thread failed: {detail}")]
     Thread { what: &'static str, detail: String },
 }
@@ -103,6 +107,30 @@ pub async fn run(
         path: state_dir.clone(),
         source,
     })?;
+    let rates = config
+        .sensors
+        .iter()
+        .map(|s| (s.id.clone(), s.sample_rate_hz))
+        .collect();
+    let (mcap, recovered) = McapSink::open(logger_config(&config), rates, wall_clock_now_ns())
+        .map_err(|e| RunError::Log(e.to_string()))?;
+    for report in &recovered {
+        eprintln!(
+            "bearingd: recovered {}: {} messages kept, {} bytes unreadable{}",
+            report.path.display(),
+            report.messages_recovered,
+            report.unreadable_bytes,
+            report
+                .problem
+                .as_ref()
+                .map(|(at, why)| format!(" (from byte {at}: {why})"))
+                .unwrap_or_default()
+        );
+    }
+    if let Some(path) = mcap.current_path() {
+        eprintln!("bearingd: logging to {}", path.display());
+    }
+    sinks.push(Box::new(mcap));
     let baselines = load_baselines(&state_dir);
     let pipeline = Pipeline::new(&config, &baselines);
     let status_board = Arc::new(Mutex::new(pipeline.status()));
@@ -339,6 +367,18 @@ pub fn status_line(s: &ChannelStatus) -> String {
         },
         if s.sensor_lost { " SENSOR LOST" } else { "" }
     )
+}
+
+/// The MCAP logger's settings from `[outputs]`.
+pub fn logger_config(config: &Config) -> LoggerConfig {
+    let o = &config.outputs;
+    LoggerConfig {
+        max_file_bytes: o.mcap_max_file_bytes(),
+        max_file_duration_ns: (o.mcap_max_file_s * 1e9) as u64,
+        disk_budget_bytes: o.mcap_disk_budget_bytes(),
+        chunk_size: (1u64 << 20).min(o.mcap_max_file_bytes() / 4).max(4096),
+        ..LoggerConfig::new(o.mcap_dir.clone())
+    }
 }
 
 const BASELINES_FILE: &str = "baselines.json";

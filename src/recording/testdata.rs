@@ -83,3 +83,59 @@ pub fn read_manifest(dir: &Path) -> Vec<std::collections::HashMap<String, String
         })
         .collect()
 }
+
+/// The project's Python with the MCAP readers (`.venv/bin/python`, made by `.ci/run`). Under
+/// `CI=true` a missing venv or package fails the test and says what is missing.
+///
+/// # Panics
+/// Under CI when the readers are missing (tests only).
+pub fn python_mcap() -> Option<PathBuf> {
+    let py = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
+    let ci = std::env::var("CI").is_ok_and(|v| v == "true");
+    let problem = if !py.exists() {
+        Some(format!("{} does not exist", py.display()))
+    } else {
+        let out = std::process::Command::new(&py)
+            .args(["-c", "import mcap, mcap_protobuf, google.protobuf"])
+            .output()
+            .expect("run python");
+        (!out.status.success()).then(|| String::from_utf8_lossy(&out.stderr).into_owned())
+    };
+    match problem {
+        None => Some(py),
+        Some(p) if ci => panic!(
+            "Python MCAP reader missing ({p}); create it with `python3 -m venv .venv && \
+             .venv/bin/pip install -r scripts/requirements-ci.txt` (mcap, mcap-protobuf-support, protobuf)"
+        ),
+        Some(p) => {
+            eprintln!("skipping the Python check: {p}");
+            None
+        }
+    }
+}
+
+/// Runs `tests/python/check_mcap.py` on `file`; returns its JSON summary.
+///
+/// # Panics
+/// When the check fails (tests only).
+pub fn check_mcap_with_python(
+    py: &Path,
+    file: &Path,
+    expected: Option<&Path>,
+) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/check_mcap.py");
+    let mut cmd = std::process::Command::new(py);
+    cmd.arg(script).arg(file);
+    if let Some(e) = expected {
+        cmd.arg(e);
+    }
+    let out = cmd.output().expect("run check_mcap.py");
+    assert!(
+        out.status.success(),
+        "check_mcap.py failed on {}:\n{}\n{}",
+        file.display(),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("summary JSON")
+}

@@ -272,7 +272,7 @@ mod tests {
         let model = EnvelopeModel::new(
             FaultKind::OuterRace,
             &freqs,
-            Band::new(0.0, 1e7),
+            Band::new(-1e7, 1e7),
             1.0,
             10,
             0.5,

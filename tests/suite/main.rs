@@ -2,6 +2,7 @@
 //! suite links once.
 
 mod cli;
+mod daemon;
 mod developer_set;
 mod envelope;
 mod kinematics;

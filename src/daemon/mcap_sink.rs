@@ -1,0 +1,109 @@
+//! The MCAP log as a sink of the daemon: maps sample time to log time, flushes the open chunk
+//! every second of data (a crash loses at most that), recovers unfinished files at start, and
+//! finishes the file at shutdown.
+
+use super::messages::PipelineMessage;
+use super::run::Sink;
+use crate::mcap_log::{recover_directory, LoggerConfig, McapLogError, McapLogger, RecoveryReport};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// Nanoseconds of log time between two flushes.
+const FLUSH_EVERY_NS: u64 = 1_000_000_000;
+
+pub struct McapSink {
+    logger: Option<McapLogger>,
+    /// Log time of sample 0 of every channel, ns since the epoch.
+    origin_ns: u64,
+    /// Sample rate per sensor, to turn sample indices into time.
+    rates: HashMap<String, f64>,
+    next_flush_ns: u64,
+    last_ns: u64,
+    errors: Vec<String>,
+    pub messages: u64,
+}
+
+impl McapSink {
+    /// Recovers what a crash left in `config.dir`, then opens a new file. `origin_ns` is the
+    /// log time of sample 0 (the daemon's start, or the original run's for a replay).
+    pub fn open(
+        config: LoggerConfig,
+        rates: HashMap<String, f64>,
+        origin_ns: u64,
+    ) -> Result<(Self, Vec<RecoveryReport>), McapLogError> {
+        std::fs::create_dir_all(&config.dir).map_err(|source| McapLogError::Io {
+            path: config.dir.clone(),
+            op: "create the log directory",
+            source,
+        })?;
+        let recovered = recover_directory(&config.dir)?;
+        let logger = McapLogger::create(config, origin_ns)?;
+        Ok((
+            McapSink {
+                logger: Some(logger),
+                origin_ns,
+                rates,
+                next_flush_ns: origin_ns + FLUSH_EVERY_NS,
+                last_ns: origin_ns,
+                errors: Vec::new(),
+                messages: 0,
+            },
+            recovered,
+        ))
+    }
+
+    pub fn current_path(&self) -> Option<&Path> {
+        self.logger.as_ref().and_then(|l| l.current_path())
+    }
+
+    fn log_time(&self, message: &PipelineMessage) -> u64 {
+        let at = |sensor: &str, sample: u64| {
+            let fs = self.rates.get(sensor).copied().unwrap_or(1.0);
+            self.origin_ns + (sample as f64 / fs * 1e9) as u64
+        };
+        match message {
+            PipelineMessage::Raw(m) => at(&m.channel.sensor, m.first_sample),
+            PipelineMessage::Spectrum(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Indicators(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Twin(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Flag(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Health(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Ingest(_) => self.last_ns,
+        }
+    }
+}
+
+impl Sink for McapSink {
+    fn write(&mut self, message: &PipelineMessage) {
+        let time = self.log_time(message);
+        self.last_ns = self.last_ns.max(time);
+        let Some(logger) = self.logger.as_mut() else {
+            return;
+        };
+        match logger.log(message, time, time) {
+            Ok(_) => self.messages += 1,
+            Err(e) if self.errors.len() < 10 => self.errors.push(e.to_string()),
+            Err(_) => {}
+        }
+        if self.last_ns >= self.next_flush_ns {
+            self.next_flush_ns = self.last_ns + FLUSH_EVERY_NS;
+            if let Err(e) = logger.flush() {
+                self.errors.push(e.to_string());
+            }
+        }
+    }
+
+    fn finish(&mut self) -> Result<(), String> {
+        let finished = self.logger.take().map(|l| l.finish());
+        if let Some(Err(e)) = finished {
+            self.errors.push(e.to_string());
+        }
+        match self.errors.first() {
+            None => Ok(()),
+            Some(first) => Err(format!(
+                "MCAP log: {} error(s), the first: {first}",
+                self.errors.len()
+            )),
+        }
+    }
+}
