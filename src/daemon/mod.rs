@@ -1,6 +1,7 @@
 //! The running service (`bearingd run`, `bearingd replay`): sources → per-channel analysis →
 //! sinks.
 //!
+//! - [`live_source`]: the SocketCAN and iceoryx2 sources mapped onto the config's channels.
 //! - [`mcap_sink`]: the MCAP log as a sink (time mapping, flushes, recovery at start).
 //! - [`replay`]: logged raw samples through the same pipeline.
 //! - [`messages`]: what flows to the sinks; the MCAP log's schema.
@@ -9,6 +10,7 @@
 //! - [`sim_source`]: the in-process simulated sensor node.
 //! - [`twin_worker`]: the twin's periodic re-fit.
 
+pub mod live_source;
 pub mod mcap_sink;
 pub mod messages;
 pub mod pipeline;

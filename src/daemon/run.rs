@@ -12,6 +12,7 @@
 //! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
 //!   them at shutdown happens there.
 
+use super::live_source::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
 use super::mcap_sink::McapSink;
 use super::messages::{ChannelId, FlagMessage, PipelineMessage};
 use super::pipeline::{ChannelStatus, Input, Output, Pipeline, TwinRequest};
@@ -39,11 +40,8 @@ pub struct RunOptions {
 /// Why `run` could not start or had to stop.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
-    #[error("sensor '{sensor}': transport '{transport}' is not available in `bearingd run` of this build; use transport = \"sim\" or the ingest command for now")]
-    TransportUnavailable {
-        sensor: String,
-        transport: &'static str,
-    },
+    #[error("source: {0}")]
+    Source(String),
     #[error("{path}: cannot create the directory: {source}; check its permissions or set outputs.state_dir / outputs.mcap_dir")]
     Directory {
         path: PathBuf,
@@ -84,24 +82,14 @@ pub async fn run(
     mut sinks: Vec<Box<dyn Sink>>,
     shutdown: impl std::future::Future<Output = ()>,
 ) -> Result<RunSummary, RunError> {
-    let mut sims = Vec::new();
-    for sensor in &config.sensors {
-        match &sensor.transport {
-            Transport::Sim(sim) => sims.push(SimSource::new(sensor, sim, SIM_BLOCK_S)),
-            Transport::Can(_) => {
-                return Err(RunError::TransportUnavailable {
-                    sensor: sensor.id.clone(),
-                    transport: "can",
-                })
-            }
-            Transport::Shm(_) => {
-                return Err(RunError::TransportUnavailable {
-                    sensor: sensor.id.clone(),
-                    transport: "shm",
-                })
-            }
-        }
-    }
+    let sims: Vec<SimSource> = config
+        .sensors
+        .iter()
+        .filter_map(|sensor| match &sensor.transport {
+            Transport::Sim(sim) => Some(SimSource::new(sensor, sim, SIM_BLOCK_S)),
+            _ => None,
+        })
+        .collect();
     let state_dir = config.outputs.state_dir.clone();
     std::fs::create_dir_all(&state_dir).map_err(|source| RunError::Directory {
         path: state_dir.clone(),
@@ -237,16 +225,35 @@ pub async fn run(
         })?;
 
     // Sources and status on the async side.
-    let feed = feed_simulated(sims, input_tx, options.clone());
+    let (stop_tx, stop_rx) = tokio::sync::watch::channel(false);
+    let mut sources = tokio::task::JoinSet::new();
+    let live = start_live_sources(&config, &input_tx, &stop_rx, &mut sources)?;
+    if !sims.is_empty() {
+        sources.spawn(feed_simulated(sims, input_tx.clone(), options.clone()));
+    }
+    drop(input_tx);
     let status = print_status(
         status_board.clone(),
         config.outputs.status_interval_s,
         options.status_lines,
     );
+    let live_deadline = async {
+        match options.duration_s.filter(|_| live) {
+            Some(seconds) => tokio::time::sleep(std::time::Duration::from_secs_f64(seconds)).await,
+            None => std::future::pending().await,
+        }
+    };
     tokio::select! {
-        _ = feed => {},
+        _ = async { while sources.join_next().await.is_some() {} } => {},
         _ = shutdown => {},
+        _ = live_deadline => {},
         _ = status => {},
+    }
+    let _ = stop_tx.send(true);
+    while let Some(finished) = sources.join_next().await {
+        if let Err(e) = finished {
+            eprintln!("bearingd: a source task failed: {e}");
+        }
     }
     // Dropping the sources' sender (inside `feed`) ends the analysis thread, which ends the
     // re-fit thread, which ends the sink thread.
@@ -276,6 +283,82 @@ pub async fn run(
         twin_fits,
         twin_requests_skipped: skipped.load(Ordering::Relaxed),
     })
+}
+
+/// Starts the SocketCAN and iceoryx2 sources of the config; `true` if there is any.
+fn start_live_sources(
+    config: &Config,
+    inputs: &tokio::sync::mpsc::Sender<Input>,
+    stop: &tokio::sync::watch::Receiver<bool>,
+    tasks: &mut tokio::task::JoinSet<()>,
+) -> Result<bool, RunError> {
+    let mut any = false;
+    let stopped = |mut stop: tokio::sync::watch::Receiver<bool>| async move {
+        let _ = stop.wait_for(|s| *s).await;
+    };
+    for (interface, map) in can_interfaces(config) {
+        any = true;
+        #[cfg(feature = "can")]
+        {
+            use crate::ingest::can;
+            let source = can::open(can::CanSourceConfig {
+                interface: interface.clone(),
+                silence_timeout: SENSOR_TIMEOUT,
+                receive_buffer_bytes: 4 << 20,
+                capture: None,
+                capture_frames: 0,
+            })
+            .map_err(|e| RunError::Source(e.to_string()))?;
+            let (events_tx, events_rx) = tokio::sync::mpsc::channel(ANALYSIS_QUEUE);
+            let shutdown = stopped(stop.clone());
+            tasks.spawn(async move {
+                if let Err(e) = source.run(events_tx, shutdown).await {
+                    eprintln!("bearingd: CAN source stopped: {e}");
+                }
+            });
+            tasks.spawn(forward(events_rx, map, inputs.clone()));
+        }
+        #[cfg(not(feature = "can"))]
+        {
+            let _ = (map, inputs, stopped);
+            return Err(RunError::Source(format!(
+                "CAN interface {interface}: this bearingd was built without the `can` feature"
+            )));
+        }
+    }
+    for (sensor, map) in shm_sensors(config) {
+        any = true;
+        #[cfg(feature = "shm")]
+        {
+            use crate::ingest::{handoff::WhenFull, shm};
+            let source = shm::ShmSourceConfig {
+                sensor: sensor.clone(),
+                iox: shm::IoxSettings {
+                    prefix: std::env::var("BEARINGD_IOX_PREFIX").ok(),
+                    root_path: Some(config.outputs.iceoryx2_root.display().to_string()),
+                },
+                silence_timeout: SENSOR_TIMEOUT,
+                handoff_capacity: 64,
+                when_full: WhenFull::DropOldest,
+            };
+            let (events_tx, events_rx) = tokio::sync::mpsc::channel(ANALYSIS_QUEUE);
+            let shutdown = stopped(stop.clone());
+            tasks.spawn(async move {
+                if let Err(e) = shm::run(source, events_tx, shutdown).await {
+                    eprintln!("bearingd: iceoryx2 source bearingd/accel/{sensor} stopped: {e}");
+                }
+            });
+            tasks.spawn(forward(events_rx, map, inputs.clone()));
+        }
+        #[cfg(not(feature = "shm"))]
+        {
+            let _ = (map, inputs, stopped);
+            return Err(RunError::Source(format!(
+                "iceoryx2 sensor {sensor}: this bearingd was built without the `shm` feature"
+            )));
+        }
+    }
+    Ok(any)
 }
 
 /// Feeds the simulated sensors' blocks, paced at real time or as fast as the queue takes them.

@@ -175,3 +175,151 @@ fn a_config_error_refuses_to_start_and_lists_every_problem() {
         "{stderr}"
     );
 }
+
+/// The firmware simulator as a separate process publishing over iceoryx2, `bearingd run`
+/// subscribing, logging to MCAP; then a replay of that log raises the same flags at the same
+/// samples.
+#[test]
+fn a_simulated_node_over_iceoryx2_through_the_daemon_and_its_replay_give_the_same_flags() {
+    let dir = scratch_dir("daemon-iox");
+    // iceoryx2's root must not sit under /tmp (the config refuses it): use the target dir.
+    let iox_root =
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("iox-{}", std::process::id()));
+    std::fs::create_dir_all(&iox_root).unwrap();
+    let prefix = format!("bdtest{}_", std::process::id());
+    let config = format!(
+        r#"
+[[sensors]]
+id = "node1"
+transport = "shm"
+sample_rate_hz = 25600
+scale_g_per_count = 0.00048828125
+axes = ["radial"]
+bearing = "skf-6205-2rs"
+[sensors.speed]
+source = "fixed"
+rpm = 1772
+[sensors.shm]
+service = "bearingd/accel/node1"
+
+[outputs]
+state_dir = "{state}"
+mcap_dir = "{mcap}"
+iceoryx2_root = "{iox}"
+"#,
+        state = dir.join("state").display(),
+        mcap = dir.join("mcap").display(),
+        iox = iox_root.display()
+    );
+    let config_path = dir.join("node1.toml");
+    std::fs::write(&config_path, config).unwrap();
+
+    let daemon = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args([
+            "run",
+            "--config",
+            config_path.to_str().unwrap(),
+            "--duration",
+            "16",
+            "--quiet",
+        ])
+        .env("BEARINGD_IOX_PREFIX", &prefix)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let firmware_sim = Path::new(env!("CARGO_BIN_EXE_bearingd")).with_file_name("firmware-sim");
+    assert!(
+        firmware_sim.exists(),
+        "{} missing: build the workspace (cargo test --workspace)",
+        firmware_sim.display()
+    );
+    let node = Command::new(&firmware_sim)
+        .args([
+            "--transport",
+            "shm",
+            "--sensor",
+            "node1",
+            "--node",
+            "1",
+            "--fault",
+            "outer",
+            "--onset",
+            "30",
+            "--rpm",
+            "1772",
+        ])
+        .args([
+            "--fs",
+            "25600",
+            "--duration",
+            "90",
+            "--speed-factor",
+            "8",
+            "--seed",
+            "3",
+            "--noise",
+            "0.1",
+        ])
+        .args([
+            "--iox-prefix",
+            &prefix,
+            "--iox-root",
+            iox_root.to_str().unwrap(),
+            "--wait-ready",
+            "20",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        node.status.success(),
+        "firmware-sim: {}",
+        String::from_utf8_lossy(&node.stderr)
+    );
+    let out = daemon.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("FLAG node1/radial: outer_race"), "{stdout}");
+
+    let live = mcap_files(&dir.join("mcap"));
+    let live_flags = logged_flags(&live);
+    let raw_samples: usize = read_messages(&live)
+        .filter_map(|m| match m.unwrap().message {
+            PipelineMessage::Raw(b) => Some(b.counts.len()),
+            _ => None,
+        })
+        .sum();
+    assert_eq!(
+        raw_samples,
+        90 * 25_600,
+        "every sample sent was logged; daemon said:\n{stdout}"
+    );
+    assert!(
+        live_flags
+            .iter()
+            .all(|f| f.1 == "outer_race" && f.4 > 30 * 25_600),
+        "{live_flags:?}"
+    );
+
+    let replay_dir = dir.join("replay");
+    let out = bearingd(&[
+        "replay",
+        "--config",
+        config_path.to_str().unwrap(),
+        "--out",
+        replay_dir.to_str().unwrap(),
+        "--quiet",
+        live[0].to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(logged_flags(&mcap_files(&replay_dir)), live_flags);
+    let _ = std::fs::remove_dir_all(&iox_root);
+}

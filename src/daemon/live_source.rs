@@ -1,0 +1,119 @@
+//! The live sources of `bearingd run`: the SocketCAN and iceoryx2 sources of
+//! [`crate::ingest`], with their events mapped from (node, axis) to the config's channels.
+//!
+//! One task per CAN interface (several nodes share a bus) and per iceoryx2 sensor. A source
+//! waits when the analysis queue is full, which pushes the loss back into the transport's own
+//! buffer, where it is counted as an exact sequence gap.
+
+use super::messages::ChannelId;
+use super::pipeline::Input;
+use crate::config::{Config, SensorConfig, Transport};
+use crate::ingest::IngestEvent;
+use std::collections::BTreeMap;
+use std::time::Duration;
+
+/// How long a node may stay silent before it is reported lost.
+pub const SENSOR_TIMEOUT: Duration = Duration::from_secs(2);
+
+/// Which sensor and axis names a node's streams belong to.
+#[derive(Debug, Clone, Default)]
+pub struct NodeMap {
+    nodes: BTreeMap<u8, (String, Vec<String>)>,
+}
+
+impl NodeMap {
+    fn insert(&mut self, node: u8, sensor: &SensorConfig) {
+        self.nodes
+            .insert(node, (sensor.id.clone(), sensor.axes.clone()));
+    }
+
+    /// The pipeline's input for a source's event; `None` for events the pipeline does not
+    /// need (metadata, speed, malformed frames: counted by the source).
+    pub fn to_input(&self, event: IngestEvent) -> Option<Input> {
+        let channel = |node: u8, axis: u8| {
+            self.nodes.get(&node).and_then(|(sensor, axes)| {
+                axes.get(usize::from(axis)).map(|a| ChannelId {
+                    sensor: sensor.clone(),
+                    axis: a.clone(),
+                })
+            })
+        };
+        match event {
+            IngestEvent::Samples(block) => Some(Input::Samples {
+                channel: channel(block.node, block.axis)?,
+                first_sample: block.first_sample,
+                scale_g_per_count: f64::from(block.scale_g_per_count),
+                counts: block.samples,
+            }),
+            IngestEvent::Restart {
+                node,
+                axis,
+                first_sample,
+            } => Some(Input::Restart {
+                channel: channel(node, axis)?,
+                first_sample,
+            }),
+            IngestEvent::SensorLost { node } => Some(Input::SensorLost {
+                sensor: self.nodes.get(&node)?.0.clone(),
+            }),
+            IngestEvent::SensorBack { node } => Some(Input::SensorBack {
+                sensor: self.nodes.get(&node)?.0.clone(),
+            }),
+            // A gap shows in the next block's first sample; the monitor reports it there.
+            _ => None,
+        }
+    }
+}
+
+/// The CAN interfaces of the config, each with the nodes on it.
+pub fn can_interfaces(config: &Config) -> BTreeMap<String, NodeMap> {
+    let mut buses: BTreeMap<String, NodeMap> = BTreeMap::new();
+    for sensor in &config.sensors {
+        if let Transport::Can(can) = &sensor.transport {
+            buses
+                .entry(can.interface.clone())
+                .or_default()
+                .insert(can.node_id, sensor);
+        }
+    }
+    buses
+}
+
+/// The iceoryx2 sensors of the config: the sensor name of its service and its map (every
+/// node on the service is the sensor).
+pub fn shm_sensors(config: &Config) -> Vec<(String, NodeMap)> {
+    config
+        .sensors
+        .iter()
+        .filter_map(|sensor| match &sensor.transport {
+            Transport::Shm(shm) => {
+                let name = shm
+                    .service
+                    .strip_prefix("bearingd/accel/")
+                    .unwrap_or(&sensor.id)
+                    .to_string();
+                let mut map = NodeMap::default();
+                for node in 0..=15 {
+                    map.insert(node, sensor);
+                }
+                Some((name, map))
+            }
+            _ => None,
+        })
+        .collect()
+}
+
+/// Forwards a source's events to the analysis queue until either side ends.
+pub async fn forward(
+    mut events: tokio::sync::mpsc::Receiver<IngestEvent>,
+    map: NodeMap,
+    inputs: tokio::sync::mpsc::Sender<Input>,
+) {
+    while let Some(event) = events.recv().await {
+        if let Some(input) = map.to_input(event) {
+            if inputs.send(input).await.is_err() {
+                return;
+            }
+        }
+    }
+}
