@@ -9,8 +9,11 @@
 //!   whole-record analysis as `bearingd analyze` (kurtogram/GK plus per-fault SNR refinement),
 //!   and the rolling envelope follows one band per fault kind. Until the first selection the
 //!   channel is learning and raises no flag.
-//! - Scores, flags: each fault's score comes from its own band's averaged envelope spectrum and
-//!   drives that fault's flag.
+//! - Scores, flags: each fault's score comes from its own band's averaged envelope spectrum;
+//!   the fault that dominates (its score at least `min_score_ratio` times every other, the
+//!   verdict's rule) drives its flag, the others' flags see 0. (choice) A second fault at the
+//!   same time shows once it dominates: this keeps one strong fault's leakage into the other
+//!   fault bands from raising false alarms.
 //! - Health: the stage tracker, fed with each window's kurtosis and RMS.
 //! - Sensor: clipping (counts at full scale) and a flat line (no change for a second) are
 //!   reported when they start and when they end.
@@ -123,6 +126,16 @@ pub struct ChannelMonitor {
     flat_since: u64,
     last_count: Option<i32>,
     analyzer: RecordAnalyzer,
+}
+
+/// The fault whose score is at least `ratio` times every other fault's, if any.
+fn dominant_fault(scores: &[FaultScore; 4], ratio: f64) -> Option<usize> {
+    let top = (0..4).max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))?;
+    let runner_up = (0..4)
+        .filter(|&i| i != top)
+        .map(|i| scores[i].score)
+        .fold(0.0, f64::max);
+    (scores[top].score >= ratio * runner_up).then_some(top)
 }
 
 /// Samples converted per chunk (the scratch buffer's size).
@@ -278,6 +291,7 @@ impl ChannelMonitor {
         self.history_filled = (self.history_filled + samples.len()).min(n);
         self.next_sample += samples.len() as u64;
 
+        let min_score_ratio = self.settings.analysis.min_score_ratio;
         let ChannelMonitor {
             rolling,
             scorer,
@@ -306,8 +320,16 @@ impl ChannelMonitor {
                 on_event(MonitorEvent::Stage(change));
             }
             if *bands_known {
+                // Only the dominating fault feeds its flag (the verdict's rule: its score at least
+                // `min_score_ratio` times every other); the others see 0 and fall.
+                let dominant = dominant_fault(scores, min_score_ratio);
                 for (i, kind) in FaultKind::ALL.iter().enumerate() {
-                    if let Some(change) = flags[i].update(scores[i].score, update.end_sample) {
+                    let score = if dominant == Some(i) {
+                        scores[i].score
+                    } else {
+                        0.0
+                    };
+                    if let Some(change) = flags[i].update(score, update.end_sample) {
                         on_event(MonitorEvent::Flag {
                             fault: *kind,
                             change,

@@ -7,6 +7,7 @@
 
 mod analyze;
 mod config_cmd;
+mod import;
 mod ingest;
 mod replay;
 mod run;
@@ -56,6 +57,8 @@ enum Command {
     /// Run the service: sources → analysis → logs and alerts. Without --config, the embedded
     /// default: a simulated sensor that develops an outer-race fault after 30 s.
     Run(run::RunArgs),
+    /// Convert a recording (.mat, .csv, WAV) into a raw MCAP log and a config to replay it with.
+    Import(import::ImportArgs),
     /// Replay MCAP logs' raw samples through the same pipeline, as fast as possible or at --speed.
     Replay(replay::ReplayArgs),
     /// Write a synthetic record of a bearing fault (the twin's signal model) as CSV or WAV.
@@ -81,6 +84,7 @@ pub fn main() -> ExitCode {
         Command::Analyze(args) => analyze::run(&args),
         Command::Run(args) => run::run_command(&args),
         Command::Replay(args) => replay::run(&args),
+        Command::Import(args) => import::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),

@@ -107,7 +107,7 @@ pub fn monitor_settings(config: &Config, sensor: &SensorConfig) -> MonitorSettin
         fs_hz: fs,
         analysis: config.analysis.clone(),
         band_period_samples: samples(config.band_period_s),
-        band_history_samples: samples(BAND_HISTORY_S) as usize,
+        band_history_samples: samples(band_history_s(config)) as usize,
         flags: FlagSettings {
             watch_score: t.watch_score,
             alarm_score: t.alarm_score,
@@ -122,8 +122,13 @@ pub fn monitor_settings(config: &Config, sensor: &SensorConfig) -> MonitorSettin
     }
 }
 
-/// Seconds of signal a band re-selection analyses.
-pub const BAND_HISTORY_S: f64 = 10.0;
+/// Seconds of signal a band re-selection analyses: the last 10 s, or one band period if that is
+/// shorter (a short recording replayed with a short period still gets its bands).
+pub fn band_history_s(config: &Config) -> f64 {
+    config.band_period_s.min(MAX_BAND_HISTORY_S)
+}
+
+const MAX_BAND_HISTORY_S: f64 = 10.0;
 
 impl Pipeline {
     /// One monitor per (sensor, axis); `baselines` resumes health stages kept across restarts.
@@ -166,7 +171,7 @@ impl Pipeline {
                         fs_hz,
                         status,
                         next_spectrum: 0,
-                        next_twin: (BAND_HISTORY_S * fs_hz) as u64,
+                        next_twin: (band_history_s(config) * fs_hz) as u64,
                     },
                 );
             }

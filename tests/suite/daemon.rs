@@ -323,3 +323,74 @@ iceoryx2_root = "{iox}"
     assert_eq!(logged_flags(&mcap_files(&replay_dir)), live_flags);
     let _ = std::fs::remove_dir_all(&iox_root);
 }
+
+/// `bearingd import` of every CWRU record, then `bearingd replay` with the config it writes:
+/// the diagnosable records (inner and outer race, 0.007 and 0.021 in) raise their fault's flag
+/// and no other; no record raises a flag of a wrong fault.
+#[test]
+fn imported_cwru_records_replayed_raise_the_right_flags() {
+    let Some(data) = bearingd::recording::testdata::shared_data_dir("cwru") else {
+        return;
+    };
+    let dir = scratch_dir("daemon-import");
+    let mut problems = Vec::new();
+    for row in bearingd::recording::testdata::read_manifest(&data) {
+        let out = dir.join(row["file"].replace(['@', '.'], "_"));
+        let imported = bearingd(&[
+            "import",
+            data.join(&row["file"]).to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(
+            imported.status.success(),
+            "{}",
+            String::from_utf8_lossy(&imported.stderr)
+        );
+        let log = mcap_files(&out);
+        let replayed = bearingd(&[
+            "replay",
+            log[0].to_str().unwrap(),
+            "--config",
+            out.join("replay.toml").to_str().unwrap(),
+            "--quiet",
+            "--json",
+            "--out",
+            out.join("replay").to_str().unwrap(),
+        ]);
+        assert!(
+            replayed.status.success(),
+            "{}",
+            String::from_utf8_lossy(&replayed.stderr)
+        );
+        let summary: serde_json::Value = serde_json::from_slice(&replayed.stdout).unwrap();
+        let raised: Vec<String> = summary["flags"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|f| f["from"] == "ok")
+            .map(|f| f["fault"].as_str().unwrap().to_string())
+            .collect();
+        let expected = match row["fault"].as_str() {
+            "inner" => "inner_race",
+            "outer" => "outer_race",
+            "ball" => "ball",
+            _ => "none",
+        };
+        let must = matches!(row["fault"].as_str(), "inner" | "outer")
+            && matches!(row["fault_size_in"].as_str(), "0.007" | "0.021");
+        if must && !raised.iter().any(|f| f == expected) {
+            problems.push(format!(
+                "{}: no {expected} flag (raised {raised:?})",
+                row["file"]
+            ));
+        }
+        if let Some(wrong) = raised.iter().find(|f| *f != expected) {
+            problems.push(format!(
+                "{}: a {wrong} flag on a {expected} record",
+                row["file"]
+            ));
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
