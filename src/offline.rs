@@ -115,25 +115,31 @@ pub fn demo_recording() -> Recording {
     }
 }
 
-/// Reads (or simulates) the record, resolves its conditions, analyses it.
-pub fn analyze(
+/// What a recording was taken under, resolved from the caller's overrides, the file and the
+/// data set's documentation; every assumption is in `warnings`.
+#[derive(Debug, Clone)]
+pub struct Conditions {
+    pub fs_hz: f64,
+    pub rpm: f64,
+    pub rpm_source: SpeedSource,
+    pub bearing: BearingGeometry,
+    pub warnings: Vec<String>,
+}
+
+/// Resolves sample rate, speed and bearing for `recording` (`request.fs_hz`, `.rpm`,
+/// `.bearing` override); used by `analyze` and `import`.
+pub fn resolve_conditions(
+    recording: &Recording,
     request: &AnalyzeRequest,
-    analyzer: &mut RecordAnalyzer,
-) -> Result<AnalyzeOutcome, OfflineError> {
-    let (recording, facts, simulated) = match &request.file {
-        Some(path) => {
-            let recording = read_recording(path, &request.read)?;
-            let facts = data_set_facts(&recording);
-            (recording, facts, false)
+    simulated: bool,
+) -> Result<Conditions, OfflineError> {
+    let facts = if simulated {
+        DataSetFacts {
+            rpm: None,
+            bearing: Some(("skf-6205-2rs", "the simulated bearing")),
         }
-        None => (
-            demo_recording(),
-            DataSetFacts {
-                rpm: None,
-                bearing: Some(("skf-6205-2rs", "the simulated bearing")),
-            },
-            true,
-        ),
+    } else {
+        data_set_facts(recording)
     };
     let file = recording.path.display().to_string();
     let fs_hz = match request.fs_hz {
@@ -194,6 +200,32 @@ pub fn analyze(
     if rpm_source == SpeedSource::DataSetDefault {
         warnings.push(format!("speed not in the file: assumed the data set's constant {rpm} rpm; give --rpm to change"));
     }
+    Ok(Conditions {
+        fs_hz,
+        rpm,
+        rpm_source,
+        bearing,
+        warnings,
+    })
+}
+
+/// Reads (or simulates) the record, resolves its conditions, analyses it.
+pub fn analyze(
+    request: &AnalyzeRequest,
+    analyzer: &mut RecordAnalyzer,
+) -> Result<AnalyzeOutcome, OfflineError> {
+    let (recording, simulated) = match &request.file {
+        Some(path) => (read_recording(path, &request.read)?, false),
+        None => (demo_recording(), true),
+    };
+    let Conditions {
+        fs_hz,
+        rpm,
+        rpm_source,
+        bearing,
+        warnings,
+    } = resolve_conditions(&recording, request, simulated)?;
+    let file = recording.path.display().to_string();
     let freqs = bearing.fault_frequencies(rpm / 60.0);
     let samples: Vec<f32> = recording.samples.iter().map(|&x| x as f32).collect();
     let analysis = analyzer

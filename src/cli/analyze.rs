@@ -1,10 +1,9 @@
 //! `bearingd analyze FILE...`: diagnose recordings and show the evidence.
 
-use super::CliError;
+use super::{CliError, RecordingArgs};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisSettings, BandSelection};
 use crate::offline::{analyze, AnalyzeRequest};
-use crate::recording::ReadOptions;
 use crate::report::{analysis_figure, render_text, AnalyzeReport};
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
@@ -34,22 +33,8 @@ pub struct AnalyzeArgs {
     /// Analyse a built-in simulated record (outer-race fault, SKF 6205-2RS, 1772 rpm, 12 kHz).
     #[arg(long, conflicts_with = "files")]
     demo: bool,
-    /// Channel: DE, FE, BA or a variable (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS).
-    #[arg(long)]
-    channel: Option<String>,
-    /// Column of a CSV table: header name or 1-based index.
-    #[arg(long)]
-    column: Option<String>,
-    /// Sample rate in Hz (overrides what the file says).
-    #[arg(long)]
-    fs: Option<f64>,
-    /// Shaft speed in rpm (overrides what the file says).
-    #[arg(long)]
-    rpm: Option<f64>,
-    /// Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia,
-    /// rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0".
-    #[arg(long)]
-    bearing: Option<String>,
+    #[command(flatten)]
+    recording: RecordingArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
     format: OutputFormat,
@@ -94,13 +79,10 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
     for file in &files {
         let request = AnalyzeRequest {
             file: file.clone(),
-            read: ReadOptions {
-                channel: args.channel.clone(),
-                column: args.column.clone(),
-            },
-            fs_hz: args.fs,
-            rpm: args.rpm,
-            bearing: args.bearing.clone(),
+            read: args.recording.read_options(),
+            fs_hz: args.recording.fs,
+            rpm: args.recording.rpm,
+            bearing: args.recording.bearing.clone(),
             settings: settings.clone(),
             twin: args.twin,
         };

@@ -2,11 +2,11 @@
 //! configuration to replay it with, so that recorded data goes through the daemon's pipeline
 //! (`bearingd replay DIR/*.mcap --config DIR/replay.toml`).
 
-use super::CliError;
-use crate::bearing::BearingGeometry;
+use super::{CliError, RecordingArgs};
 use crate::daemon::messages::{ChannelId, PipelineMessage, RawBlock};
 use crate::mcap_log::{LoggerConfig, McapLogger};
-use crate::recording::{read_recording, ReadOptions};
+use crate::offline::{resolve_conditions, AnalyzeRequest};
+use crate::recording::read_recording;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -17,19 +17,8 @@ pub struct ImportArgs {
     /// Directory for the MCAP log and replay.toml.
     #[arg(long)]
     out: PathBuf,
-    #[arg(long)]
-    channel: Option<String>,
-    #[arg(long)]
-    column: Option<String>,
-    /// Sample rate, Hz (when the file does not state it).
-    #[arg(long)]
-    fs: Option<f64>,
-    /// Shaft speed, rpm (when the file does not state it).
-    #[arg(long)]
-    rpm: Option<f64>,
-    /// Bearing (default: the data set's, for CWRU, PRONOSTIA and IMS files).
-    #[arg(long)]
-    bearing: Option<String>,
+    #[command(flatten)]
+    recording: RecordingArgs,
     /// Sensor id in the log.
     #[arg(long, default_value = "imported")]
     sensor: String,
@@ -41,37 +30,28 @@ const FULL_SCALE_COUNTS: f64 = 30_000.0;
 const BLOCK_S: f64 = 0.1;
 
 pub fn run(args: &ImportArgs) -> Result<(), CliError> {
-    let recording = read_recording(
-        &args.file,
-        &ReadOptions {
-            channel: args.channel.clone(),
-            column: args.column.clone(),
-        },
-    )
-    .map_err(CliError::input)?;
-    let file = args.file.display();
-    let fs = args.fs.or(recording.fs_hz).ok_or_else(|| {
-        CliError::input(format!(
-            "{file}: the sample rate is unknown; give --fs, e.g. --fs 12000"
-        ))
-    })?;
-    let rpm = args.rpm.or(recording.rpm).ok_or_else(|| {
-        CliError::input(format!(
-            "{file}: the shaft speed is unknown; give --rpm, e.g. --rpm 1797"
-        ))
-    })?;
-    let bearing_name = match (&args.bearing, recording.format) {
-        (Some(b), _) => b.clone(),
-        (None, crate::recording::RecordingFormat::CwruMat) => "skf-6205-2rs".into(),
-        (None, crate::recording::RecordingFormat::PronostiaCsv) => "pronostia".into(),
-        (None, crate::recording::RecordingFormat::ImsText) => "rexnord-za-2115".into(),
-        (None, _) => {
-            return Err(CliError::input(format!(
-                "{file}: which bearing is it? give --bearing, e.g. --bearing skf-6205-2rs"
-            )))
-        }
+    let recording =
+        read_recording(&args.file, &args.recording.read_options()).map_err(CliError::input)?;
+    let request = AnalyzeRequest {
+        fs_hz: args.recording.fs,
+        rpm: args.recording.rpm,
+        bearing: args.recording.bearing.clone(),
+        ..Default::default()
     };
-    BearingGeometry::parse(&bearing_name).map_err(CliError::input)?;
+    let conditions = resolve_conditions(&recording, &request, false).map_err(CliError::input)?;
+    for warning in &conditions.warnings {
+        eprintln!("bearingd: import: {warning}");
+    }
+    let (fs, rpm) = (conditions.fs_hz, conditions.rpm);
+    let bearing = &conditions.bearing;
+    let bearing_spec = format!(
+        "z={},d={}mm,D={}mm,alpha={}",
+        bearing.rolling_elements,
+        bearing.element_diameter_mm,
+        bearing.pitch_diameter_mm,
+        bearing.contact_angle_deg
+    );
+    let file = args.file.display();
     let peak = recording.samples.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let scale = if peak > 0.0 {
         peak / FULL_SCALE_COUNTS
@@ -103,7 +83,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     logger.finish().map_err(CliError::failure)?;
     let config = format!(
         "# Replays {file} (bearingd import): bearingd replay {out}/*.mcap --config {out}/replay.toml\n\
-         [[sensors]]\nid = \"{sensor}\"\ntransport = \"shm\"\nsample_rate_hz = {fs}\nscale_g_per_count = {scale:e}\naxes = [\"radial\"]\nbearing = \"{bearing_name}\"\n\
+         [[sensors]]\nid = \"{sensor}\"\ntransport = \"shm\"\nsample_rate_hz = {fs}\nscale_g_per_count = {scale:e}\naxes = [\"radial\"]\nbearing = \"{bearing_spec}\"\n\
          [sensors.speed]\nsource = \"fixed\"\nrpm = {rpm}\n\n\
          # A recording is short: choose bands every 3 s and raise flags after 1 s.\n\
          [analysis]\nband_period_s = 3.0\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 5.0\nbaseline_windows = 5\n\n\

@@ -13,8 +13,38 @@ mod replay;
 mod run;
 mod simulate;
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
 use std::process::ExitCode;
+
+/// How to read a recording and what it was taken under: shared by `analyze` and `import`.
+#[derive(Args)]
+pub struct RecordingArgs {
+    /// Channel: DE, FE, BA or a variable (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS).
+    #[arg(long)]
+    pub channel: Option<String>,
+    /// Column of a CSV table: header name or 1-based index.
+    #[arg(long)]
+    pub column: Option<String>,
+    /// Sample rate in Hz (overrides what the file says).
+    #[arg(long)]
+    pub fs: Option<f64>,
+    /// Shaft speed in rpm (overrides what the file says).
+    #[arg(long)]
+    pub rpm: Option<f64>,
+    /// Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia,
+    /// rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0".
+    #[arg(long)]
+    pub bearing: Option<String>,
+}
+
+impl RecordingArgs {
+    pub fn read_options(&self) -> crate::recording::ReadOptions {
+        crate::recording::ReadOptions {
+            channel: self.channel.clone(),
+            column: self.column.clone(),
+        }
+    }
+}
 
 /// An error on its way to the user: the message and the exit code.
 #[derive(Debug)]
