@@ -35,6 +35,18 @@ impl Default for FftPlans {
 }
 
 impl FftPlans {
+    /// One cache for the whole process, for the daemon's many channels: plans and Hann
+    /// windows of a size exist once, not once per channel. Locked only while planning
+    /// (construction and band changes), never per hop.
+    pub fn shared() -> std::sync::MutexGuard<'static, FftPlans> {
+        static SHARED: std::sync::OnceLock<std::sync::Mutex<FftPlans>> = std::sync::OnceLock::new();
+        let mutex = SHARED.get_or_init(|| std::sync::Mutex::new(FftPlans::default()));
+        // A panic while planning cannot leave the cache inconsistent: take it as it is.
+        mutex
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
     fn hann(&mut self, len: usize) -> Arc<[f32]> {
         self.hann
             .entry(len)
@@ -385,7 +397,6 @@ pub struct RollingEnvelope {
     until_update: usize,
     samples_seen: u64,
     transform: WindowTransform,
-    plans: FftPlans,
     bands: Vec<RollingBand>,
     history_used: usize,
     history_next: usize,
@@ -400,8 +411,7 @@ impl RollingEnvelope {
         bands: &[Band],
         spectrum_bins: usize,
     ) -> Self {
-        let mut plans = FftPlans::default();
-        let transform = WindowTransform::new(window, &mut plans);
+        let transform = WindowTransform::new(window, &mut FftPlans::shared());
         let mut rolling = RollingEnvelope {
             fs_hz,
             hop: hop.clamp(1, window),
@@ -412,7 +422,6 @@ impl RollingEnvelope {
             until_update: window,
             samples_seen: 0,
             transform,
-            plans,
             bands: Vec::new(),
             history_used: 0,
             history_next: 0,
@@ -445,10 +454,11 @@ impl RollingEnvelope {
     /// hop). The averages restart, since spectra of different bands do not mix.
     pub fn set_bands(&mut self, bands: &[Band]) {
         let (bins, averages, window) = (self.spectrum_bins, self.averages, self.ring.len());
+        let mut plans = FftPlans::shared();
         self.bands = bands
             .iter()
             .map(|&band| RollingBand {
-                envelope: BandEnvelope::new(band, self.fs_hz, window, bins, &mut self.plans),
+                envelope: BandEnvelope::new(band, self.fs_hz, window, bins, &mut plans),
                 latest: vec![0.0; bins],
                 history: vec![0.0; averages * bins],
                 averaged: vec![0.0; bins],

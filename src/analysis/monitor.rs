@@ -20,12 +20,13 @@
 //!
 //! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
 
+use super::envelope::FftPlans;
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultKind, FaultScore, FaultScorer};
 use super::flags::{FaultFlag, FlagChange, FlagSettings};
 use super::health::{Baseline, HealthTracker, StageChange};
 use super::indicators::Indicators;
-use super::record::{envelope_range_hz, RecordAnalyzer};
+use super::record::{analyze_with_plans, envelope_range_hz};
 use super::{AnalysisSettings, Band};
 use crate::bearing::FaultFrequencies;
 
@@ -113,8 +114,11 @@ pub struct ChannelMonitor {
     scores: [FaultScore; 4],
     bands: [Band; 4],
     bands_known: bool,
-    /// The last `band_history_samples` samples, for band re-selection.
-    history: Vec<f32>,
+    /// The last `band_history_samples` samples, for band re-selection, kept as the sensor's
+    /// integer counts (half the memory of f32: this is most of a channel's memory).
+    history: Vec<i16>,
+    /// g per count of the samples in `history`.
+    history_scale: f64,
     history_at: usize,
     history_filled: usize,
     next_band_selection: u64,
@@ -125,7 +129,6 @@ pub struct ChannelMonitor {
     flat: bool,
     flat_since: u64,
     last_count: Option<i32>,
-    analyzer: RecordAnalyzer,
 }
 
 /// The fault whose score is at least `ratio` times every other fault's, if any.
@@ -154,6 +157,8 @@ impl ChannelMonitor {
             ((envelope_range_hz(&freqs, settings.analysis.harmonics) / bin_hz).ceil() as usize + 1)
                 .min(window / 2);
         let whole = Band::new(0.0, settings.fs_hz / 2.0);
+        // No band engines until the first selection: they would be full-band (large) and
+        // unused, since no flag rises before the bands are known.
         let mut scorer = FaultScorer::new(
             settings.analysis.fault_tolerance,
             settings.analysis.harmonics,
@@ -175,7 +180,8 @@ impl ChannelMonitor {
             scores,
             bands: [whole; 4],
             bands_known: false,
-            history: vec![0.0; settings.band_history_samples.max(window)],
+            history: vec![0; settings.band_history_samples.max(window)],
+            history_scale: 1.0,
             history_at: 0,
             history_filled: 0,
             next_band_selection: settings.band_history_samples.max(window) as u64,
@@ -186,7 +192,6 @@ impl ChannelMonitor {
             flat: false,
             flat_since: 0,
             last_count: None,
-            analyzer: RecordAnalyzer::default(),
             freqs,
             settings,
         }
@@ -222,7 +227,7 @@ impl ChannelMonitor {
         let len = len.min(self.history_filled);
         let n = self.history.len();
         (0..len)
-            .map(|i| self.history[(self.history_at + n - len + i) % n])
+            .map(|i| self.history_sample((self.history_at + n - len + i) % n))
             .collect()
     }
 
@@ -247,6 +252,11 @@ impl ChannelMonitor {
             self.history_filled = 0;
             self.next_sample = first_sample;
             self.last_count = None;
+        }
+        if scale_g_per_count != self.history_scale {
+            // A new scale (a reconfigured sensor): the history in the old one is dropped.
+            self.history_scale = scale_g_per_count;
+            self.history_filled = 0;
         }
         for chunk in counts.chunks(CHUNK) {
             self.check_sensor(chunk, on_event);
@@ -284,8 +294,10 @@ impl ChannelMonitor {
     fn analyse(&mut self, samples: &[f32], on_event: &mut impl FnMut(MonitorEvent)) {
         // Keep the history for band selection.
         let n = self.history.len();
+        let per_count = 1.0 / self.history_scale;
         for &x in samples {
-            self.history[self.history_at] = x;
+            // Exact: x is a count times the scale, rounded to f32 (relative error 6e-8).
+            self.history[self.history_at] = (f64::from(x) * per_count).round() as i16;
             self.history_at = (self.history_at + 1) % n;
         }
         self.history_filled = (self.history_filled + samples.len()).min(n);
@@ -306,13 +318,13 @@ impl ChannelMonitor {
         rolling.push(samples, |update| {
             let indicators =
                 Indicators::of_slices(&[update.window_samples.0, update.window_samples.1]);
+            // Before the first band selection there are no band engines: nothing to score.
             for (i, kind) in FaultKind::ALL.iter().enumerate() {
-                scores[i] = scorer.score(
-                    update.bands[i].averaged_amplitude(),
-                    update.bin_hz,
-                    *kind,
-                    freqs,
-                );
+                let spectrum = update
+                    .bands
+                    .get(i)
+                    .map_or(&[][..], |b| b.averaged_amplitude());
+                scores[i] = scorer.score(spectrum, update.bin_hz, *kind, freqs);
             }
             if let Some(change) =
                 health.update(indicators.kurtosis, indicators.rms, update.end_sample)
@@ -347,26 +359,35 @@ impl ChannelMonitor {
                 indicators,
                 scores,
                 bands,
-                spectrum: update.bands[top].averaged_amplitude(),
-                spectrum_band: update.bands[top].band(),
+                spectrum: update
+                    .bands
+                    .get(top)
+                    .map_or(&[][..], |b| b.averaged_amplitude()),
+                spectrum_band: update.bands.get(top).map_or(bands[top], |b| b.band()),
                 bin_hz: update.bin_hz,
                 windows_averaged: update.windows_averaged,
             }));
         });
     }
 
+    fn history_sample(&self, index: usize) -> f32 {
+        (f64::from(self.history[index]) * self.history_scale) as f32
+    }
+
     /// Runs the whole-record analysis over the history and follows its bands.
     fn select_bands(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
         let n = self.history.len();
         let contiguous: Vec<f32> = (0..n)
-            .map(|i| self.history[(self.history_at + i) % n])
+            .map(|i| self.history_sample((self.history_at + i) % n))
             .collect();
-        let Ok(analysis) = self.analyzer.analyze(
+        let analysis = analyze_with_plans(
+            &mut FftPlans::shared(),
             &contiguous,
             self.settings.fs_hz,
             &self.freqs,
             &self.settings.analysis,
-        ) else {
+        );
+        let Ok(analysis) = analysis else {
             return;
         };
         let band_of = |kind: FaultKind| {

@@ -117,6 +117,19 @@ impl RecordAnalyzer {
         freqs: &FaultFrequencies,
         settings: &AnalysisSettings,
     ) -> Result<RecordAnalysis, AnalysisError> {
+        analyze_with_plans(&mut self.plans, signal, fs_hz, freqs, settings)
+    }
+}
+
+/// [`RecordAnalyzer::analyze`] with the caller's plan cache (the daemon's channels share one).
+pub fn analyze_with_plans(
+    plans: &mut FftPlans,
+    signal: &[f32],
+    fs_hz: f64,
+    freqs: &FaultFrequencies,
+    settings: &AnalysisSettings,
+) -> Result<RecordAnalysis, AnalysisError> {
+    {
         if !(fs_hz.is_finite() && fs_hz > 0.0) {
             return Err(AnalysisError::BadSampleRate(fs_hz));
         }
@@ -166,7 +179,7 @@ impl RecordAnalyzer {
         };
         let with_gini = matches!(settings.band_selection, BandSelection::GiniKurtosis);
         let scan = scan_bands(
-            &mut self.plans,
+            plans,
             signal,
             fs_hz,
             window,
