@@ -459,7 +459,7 @@ pub fn logger_config(config: &Config) -> LoggerConfig {
         max_file_bytes: o.mcap_max_file_bytes(),
         max_file_duration_ns: (o.mcap_max_file_s * 1e9) as u64,
         disk_budget_bytes: o.mcap_disk_budget_bytes(),
-        chunk_size: (1u64 << 20).min(o.mcap_max_file_bytes() / 4).max(4096),
+        chunk_size: (1u64 << 19).min(o.mcap_max_file_bytes() / 4).max(4096),
         ..LoggerConfig::new(o.mcap_dir.clone())
     }
 }
