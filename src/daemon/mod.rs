@@ -13,6 +13,7 @@
 pub mod live_source;
 pub mod mcap_sink;
 pub mod messages;
+pub mod notify;
 pub mod pipeline;
 pub mod replay;
 pub mod run;

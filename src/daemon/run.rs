@@ -15,6 +15,7 @@
 use super::live_source::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
 use super::mcap_sink::McapSink;
 use super::messages::{ChannelId, FlagMessage, PipelineMessage};
+use super::notify::{keep_alive, Notifier};
 use super::pipeline::{ChannelStatus, Input, Output, Pipeline, TwinRequest};
 use super::sim_source::SimSource;
 use super::twin_worker::TwinWorker;
@@ -124,6 +125,10 @@ pub async fn run(
     let status_board = Arc::new(Mutex::new(pipeline.status()));
     let twin_board: Arc<Mutex<BTreeMap<ChannelId, (String, f64)>>> = Arc::default();
     let skipped = Arc::new(AtomicU64::new(0));
+    // Liveness for systemd's watchdog: the analysis thread bumps it after every input, the
+    // notify task reads it. An atomic, not the status board, because it must advance even when
+    // an input changes no status (a SensorLost, a short block).
+    let heartbeat = Arc::new(AtomicU64::new(0));
 
     let (input_tx, mut input_rx) = tokio::sync::mpsc::channel::<Input>(ANALYSIS_QUEUE);
     let (sink_tx, sink_rx) = mpsc::sync_channel::<PipelineMessage>(SINK_QUEUE);
@@ -135,6 +140,7 @@ pub async fn run(
         let status_board = status_board.clone();
         let twin_board = twin_board.clone();
         let skipped = skipped.clone();
+        let heartbeat = heartbeat.clone();
         let state_dir = state_dir.clone();
         std::thread::Builder::new()
             .name("bearingd-analysis".into())
@@ -159,6 +165,7 @@ pub async fn run(
                     if let Ok(mut board) = status_board.lock() {
                         *board = pipeline.status();
                     }
+                    heartbeat.fetch_add(1, Ordering::Relaxed);
                 }
                 save_baselines(&state_dir, &pipeline.baselines());
             })
@@ -231,7 +238,37 @@ pub async fn run(
     if !sims.is_empty() {
         sources.spawn(feed_simulated(sims, input_tx.clone(), options.clone()));
     }
+    // A weak handle on the analysis queue, to see whether inputs wait there; it does not keep
+    // the queue open, so the analysis thread still ends when the sources do.
+    let analysis_queue = input_tx.downgrade();
     drop(input_tx);
+    // systemd (Type=notify): ready once the log is open, the threads run and the sources are
+    // started. A no-op without $NOTIFY_SOCKET.
+    let notifier = Notifier::from_env();
+    notifier.ready();
+    let mut last_beat = 0;
+    let supervise = keep_alive(
+        &notifier,
+        std::time::Duration::from_secs_f64(config.outputs.status_interval_s),
+        || {
+            status_board
+                .lock()
+                .map(|b| systemd_status(&b))
+                .unwrap_or_default()
+        },
+        // The watchdog rule: alive if the analysis thread took an input since the last check,
+        // or if no input waits for it (a silent sensor is reported as lost, not cured by a
+        // restart). Inputs waiting and no progress for the whole WatchdogSec: no more pings.
+        || {
+            let beat = heartbeat.load(Ordering::Relaxed);
+            let progressed = beat != last_beat;
+            last_beat = beat;
+            let idle = analysis_queue
+                .upgrade()
+                .is_none_or(|queue| queue.capacity() == queue.max_capacity());
+            progressed || idle
+        },
+    );
     let status = print_status(
         status_board.clone(),
         config.outputs.status_interval_s,
@@ -248,7 +285,9 @@ pub async fn run(
         _ = shutdown => {},
         _ = live_deadline => {},
         _ = status => {},
+        _ = supervise => {},
     }
+    notifier.stopping();
     let _ = stop_tx.send(true);
     while let Some(finished) = sources.join_next().await {
         if let Err(e) = finished {
@@ -450,6 +489,36 @@ pub fn status_line(s: &ChannelStatus) -> String {
         },
         if s.sensor_lost { " SENSOR LOST" } else { "" }
     )
+}
+
+/// The one-line `STATUS=` for systemd (`systemctl status`): channel count, then per channel its
+/// sample time, health stage and raised flags; shorter than [`status_line`].
+fn systemd_status(board: &[ChannelStatus]) -> String {
+    let channels: Vec<String> = board
+        .iter()
+        .map(|s| {
+            let flags: Vec<String> = crate::analysis::FaultKind::ALL
+                .iter()
+                .zip(&s.flags)
+                .filter(|(_, l)| l.name() != "ok")
+                .map(|(k, l)| format!("{}={}", k.name(), l.name()))
+                .collect();
+            let flags = if flags.is_empty() {
+                "ok".to_string()
+            } else {
+                flags.join(",")
+            };
+            let lost = if s.sensor_lost { " SENSOR LOST" } else { "" };
+            format!(
+                "{} t={:.1}s {} {flags}{lost}",
+                s.channel,
+                s.seconds,
+                s.stage.name()
+            )
+        })
+        .collect();
+    let plural = if board.len() == 1 { "" } else { "s" };
+    format!("{} channel{plural}; {}", board.len(), channels.join("; "))
 }
 
 /// The MCAP logger's settings from `[outputs]`.

@@ -1,0 +1,144 @@
+//! systemd's notify protocol, end to end: `bearingd run` under a `NOTIFY_SOCKET` this test
+//! listens on, as systemd would with `Type=notify` and `WatchdogSec=`.
+//!
+//! Why a real process and a real socket: what matters is what systemd would receive (the
+//! datagrams, their order, the watchdog pings while the pipeline runs), not the calls inside.
+
+use std::os::unix::net::UnixDatagram;
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+type TestResult = Result<(), Box<dyn std::error::Error>>;
+
+/// One simulated sensor, status every 0.5 s, state and logs in `dir`.
+fn write_config(dir: &Path) -> std::io::Result<std::path::PathBuf> {
+    let path = dir.join("bearingd.toml");
+    let text = format!(
+        r#"
+[[sensors]]
+id = "motor-de"
+transport = "sim"
+sample_rate_hz = 25600
+axes = ["radial"]
+bearing = "skf-6205-2rs"
+[sensors.speed]
+source = "fixed"
+rpm = 1772
+
+[outputs]
+state_dir = "{state}"
+mcap_dir = "{mcap}"
+status_interval_s = 0.5
+"#,
+        state = dir.join("state").display(),
+        mcap = dir.join("mcap").display(),
+    );
+    std::fs::write(&path, text)?;
+    Ok(path)
+}
+
+#[test]
+fn run_notifies_ready_status_watchdog_then_stopping() -> TestResult {
+    let dir = tempfile::tempdir()?;
+    let socket_path = dir.path().join("notify.sock");
+    let listener = UnixDatagram::bind(&socket_path)?;
+    listener.set_read_timeout(Some(Duration::from_millis(200)))?;
+    let config = write_config(dir.path())?;
+
+    // 4 s of sample time in real time: long enough for several STATUS (every 0.5 s) and
+    // WATCHDOG (every 1 s, half of WATCHDOG_USEC) datagrams.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .arg("run")
+        .arg("--config")
+        .arg(&config)
+        .args(["--duration", "4", "--quiet"])
+        .env("NOTIFY_SOCKET", &socket_path)
+        .env("WATCHDOG_USEC", "2000000")
+        .env_remove("WATCHDOG_PID")
+        .stdout(Stdio::null())
+        .spawn()?;
+
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let mut messages: Vec<String> = Vec::new();
+    let mut buffer = [0u8; 4096];
+    let exit = loop {
+        match listener.recv(&mut buffer) {
+            Ok(n) => messages.push(String::from_utf8_lossy(&buffer[..n]).into_owned()),
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) => {}
+            Err(e) => return Err(e.into()),
+        }
+        if let Some(status) = child.try_wait()? {
+            break status;
+        }
+        if Instant::now() > deadline {
+            child.kill()?;
+            child.wait()?;
+            return Err(format!("bearingd still running after 60 s; got {messages:?}").into());
+        }
+    };
+    // What was sent just before the exit is still queued on the socket.
+    listener.set_nonblocking(true)?;
+    while let Ok(n) = listener.recv(&mut buffer) {
+        messages.push(String::from_utf8_lossy(&buffer[..n]).into_owned());
+    }
+
+    assert!(exit.success(), "bearingd exited with {exit}");
+    assert_eq!(
+        messages.first().map(String::as_str),
+        Some("READY=1"),
+        "READY=1 comes first: {messages:?}"
+    );
+    assert_eq!(
+        messages.iter().filter(|m| *m == "READY=1").count(),
+        1,
+        "{messages:?}"
+    );
+    let statuses: Vec<&String> = messages
+        .iter()
+        .filter(|m| m.starts_with("STATUS="))
+        .collect();
+    assert!(
+        statuses
+            .iter()
+            .any(|m| m.starts_with("STATUS=1 channel; ") && m.contains("motor-de/radial")),
+        "a STATUS= naming the channel: {messages:?}"
+    );
+    assert!(
+        statuses.iter().all(|m| !m.contains('\n')),
+        "one line per STATUS: {statuses:?}"
+    );
+    assert!(
+        messages.iter().any(|m| m == "WATCHDOG=1"),
+        "the running pipeline pings the watchdog: {messages:?}"
+    );
+    assert_eq!(
+        messages.last().map(String::as_str),
+        Some("STOPPING=1"),
+        "STOPPING=1 comes last: {messages:?}"
+    );
+    Ok(())
+}
+
+#[test]
+fn run_without_notify_socket_is_unchanged() -> TestResult {
+    // No NOTIFY_SOCKET: no notifications, no complaint on stderr, a normal exit.
+    let dir = tempfile::tempdir()?;
+    let config = write_config(dir.path())?;
+    let output = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .arg("run")
+        .arg("--config")
+        .arg(&config)
+        .args(["--duration", "2", "--fast", "--quiet"])
+        .env_remove("NOTIFY_SOCKET")
+        .env_remove("WATCHDOG_USEC")
+        .output()?;
+    assert!(output.status.success(), "{output:?}");
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("notify"), "{stderr}");
+    Ok(())
+}
