@@ -5,6 +5,7 @@
 //! - [`mcap_sink`]: the MCAP log as a sink (time mapping, flushes, recovery at start).
 //! - [`replay`]: logged raw samples through the same pipeline.
 //! - [`messages`]: what flows to the sinks; the MCAP log's schema.
+//! - [`notify`]: the systemd notify protocol (READY, STATUS, WATCHDOG, STOPPING).
 //! - [`pipeline`]: the analysis stage shared by `run` and `replay` (sample time only).
 //! - [`run`]: threads, queues, shutdown and status of `bearingd run`.
 //! - [`sim_source`]: the in-process simulated sensor node.
