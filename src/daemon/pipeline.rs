@@ -93,7 +93,10 @@ struct Channel {
 /// The analysis stage.
 pub struct Pipeline {
     channels: BTreeMap<ChannelId, Channel>,
-    spectrum_every_samples: f64,
+    /// Blocks of channels the config does not know, per channel: skipped, counted, reported.
+    unknown: BTreeMap<ChannelId, u64>,
+    /// Seconds of sample time between two logged spectra (Foxglove plots below ~60 Hz).
+    spectrum_every_s: f64,
     twin_period_s: f64,
     twin_window_s: f64,
 }
@@ -121,6 +124,9 @@ pub fn monitor_settings(config: &Config, sensor: &SensorConfig) -> MonitorSettin
         flat_line_samples: samples(1.0),
     }
 }
+
+/// Seconds of sample time between two logged spectra.
+const SPECTRUM_EVERY_S: f64 = 1.0;
 
 /// Seconds of signal a band re-selection analyses: the last 10 s, or one band period if that is
 /// shorter (a short recording replayed with a short period still gets its bands).
@@ -178,10 +184,16 @@ impl Pipeline {
         }
         Pipeline {
             channels,
-            spectrum_every_samples: 1.0,
+            unknown: BTreeMap::new(),
+            spectrum_every_s: SPECTRUM_EVERY_S,
             twin_period_s: config.twin.refit_period_s,
             twin_window_s: config.twin.window_s,
         }
+    }
+
+    /// Channels that sent blocks the config does not know, with the number of blocks skipped.
+    pub fn unknown_channels(&self) -> &BTreeMap<ChannelId, u64> {
+        &self.unknown
     }
 
     pub fn channels(&self) -> impl Iterator<Item = &ChannelId> {
@@ -216,9 +228,10 @@ impl Pipeline {
                 scale_g_per_count,
                 counts,
             } => {
-                let spectrum_every_samples = self.spectrum_every_samples;
+                let spectrum_every_s = self.spectrum_every_s;
                 let (twin_period_s, twin_window_s) = (self.twin_period_s, self.twin_window_s);
                 let Some(c) = self.channels.get_mut(&channel) else {
+                    *self.unknown.entry(channel).or_default() += 1;
                     return;
                 };
                 out(Output::Message(PipelineMessage::Raw(RawBlock {
@@ -239,7 +252,7 @@ impl Pipeline {
                     handle_event(
                         &channel,
                         fs,
-                        spectrum_every_samples,
+                        spectrum_every_s,
                         next_spectrum,
                         status,
                         event,

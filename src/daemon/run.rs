@@ -168,6 +168,9 @@ pub async fn run(
                     heartbeat.fetch_add(1, Ordering::Relaxed);
                 }
                 save_baselines(&state_dir, &pipeline.baselines());
+                for (channel, blocks) in pipeline.unknown_channels() {
+                    eprintln!("bearingd: {blocks} blocks of {channel} skipped: no such sensor/axis in the config");
+                }
             })
             .map_err(|e| RunError::Thread {
                 what: "analysis",
