@@ -220,7 +220,7 @@ iceoryx2_root = "{iox}"
             "--config",
             config_path.to_str().unwrap(),
             "--duration",
-            "16",
+            "24",
             "--quiet",
         ])
         .env("BEARINGD_IOX_PREFIX", &prefix)
@@ -245,7 +245,7 @@ iceoryx2_root = "{iox}"
             "--fault",
             "outer",
             "--onset",
-            "30",
+            "20",
             "--rpm",
             "1772",
         ])
@@ -253,9 +253,9 @@ iceoryx2_root = "{iox}"
             "--fs",
             "25600",
             "--duration",
-            "90",
+            "60",
             "--speed-factor",
-            "8",
+            "4",
             "--seed",
             "3",
             "--noise",
@@ -295,13 +295,13 @@ iceoryx2_root = "{iox}"
         .sum();
     assert_eq!(
         raw_samples,
-        90 * 25_600,
+        60 * 25_600,
         "every sample sent was logged; daemon said:\n{stdout}"
     );
     assert!(
         live_flags
             .iter()
-            .all(|f| f.1 == "outer_race" && f.4 > 30 * 25_600),
+            .all(|f| f.1 == "outer_race" && f.4 > 20 * 25_600),
         "{live_flags:?}"
     );
 
