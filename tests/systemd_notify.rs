@@ -29,10 +29,12 @@ rpm = 1772
 [outputs]
 state_dir = "{state}"
 mcap_dir = "{mcap}"
+iceoryx2_root = "{iox}"
 status_interval_s = 0.5
 "#,
         state = dir.join("state").display(),
         mcap = dir.join("mcap").display(),
+        iox = dir.join("iceoryx2").display(),
     );
     std::fs::write(&path, text)?;
     Ok(path)

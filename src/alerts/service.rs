@@ -216,6 +216,9 @@ pub struct AlertSubscriber {
     subscriber: iceoryx2::port::subscriber::Subscriber<ipc::Service, Alert, ()>,
     wake: iceoryx2::port::listener::Listener<ipc::Service>,
     last: Option<(u64, u64)>,
+    /// The next alert of a run is expected to be its first (sequence 1): the history was
+    /// empty when we subscribed, or a new run began.
+    expect_first: bool,
     pending: std::collections::VecDeque<Received>,
     /// The service's history size: how many alerts a new subscriber is handed.
     pub history_size: usize,
@@ -253,9 +256,26 @@ impl AlertSubscriber {
             subscriber,
             wake,
             last: None,
+            expect_first: false,
             pending: Default::default(),
             history_size,
         })
+    }
+
+    /// What the service's history hands a new subscriber, waiting `wait` for it: the alerts
+    /// of this run, oldest first (the active ones among them). An empty history means the
+    /// daemon has published nothing yet, so its next alert must be number 1; a higher one
+    /// is reported as lost alerts.
+    pub fn take_history(&mut self, wait: Duration) -> Vec<Received> {
+        let end = Instant::now() + wait;
+        let mut history = Vec::new();
+        while let Some(received) = self.next(end.saturating_duration_since(Instant::now())) {
+            history.push(received);
+        }
+        if history.is_empty() {
+            self.expect_first = true;
+        }
+        history
     }
 
     /// The next alert (or loss, or restart), waiting at most `timeout`; `None` if nothing came.
@@ -283,26 +303,155 @@ impl AlertSubscriber {
     fn drain(&mut self) {
         while let Ok(Some(sample)) = self.subscriber.receive() {
             let alert = *sample.payload();
-            match self.last {
-                Some((run, seq)) if run == alert.run_id => {
-                    if alert.sequence <= seq {
-                        continue; // already seen (history handed again)
-                    }
-                    if alert.sequence > seq + 1 {
-                        self.pending.push_back(Received::Lost {
-                            run_id: run,
-                            first: seq + 1,
-                            last: alert.sequence - 1,
-                        });
-                    }
+            let expected = match self.last {
+                Some((run, seq)) if run == alert.run_id => Some(seq + 1),
+                Some(_) => {
+                    self.pending.push_back(Received::NewRun {
+                        run_id: alert.run_id,
+                    });
+                    Some(1)
                 }
-                Some(_) => self.pending.push_back(Received::NewRun {
-                    run_id: alert.run_id,
-                }),
-                None => {}
+                None => self.expect_first.then_some(1),
+            };
+            if let Some(expected) = expected {
+                if alert.sequence < expected {
+                    continue; // already seen (history handed again)
+                }
+                if alert.sequence > expected {
+                    self.pending.push_back(Received::Lost {
+                        run_id: alert.run_id,
+                        first: expected,
+                        last: alert.sequence - 1,
+                    });
+                }
             }
             self.last = Some((alert.run_id, alert.sequence));
             self.pending.push_back(Received::Alert(alert));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::alerts::payload::{name_field, AlertState, ALERT_VERSION};
+    use crate::recording::testdata::scratch_dir;
+
+    fn alert(sequence: u64) -> Alert {
+        Alert {
+            sequence,
+            run_id: 42,
+            end_sample: sequence * 100,
+            wall_time_ns: 0,
+            sample_rate_hz: 12_000.0,
+            fault_frequency_hz: 107.0,
+            score: 30.0,
+            confidence: 0.9,
+            twin_error: 0.25, // not NaN: the tests compare alerts with ==
+            version: ALERT_VERSION,
+            state: AlertState::Raised as u8,
+            fault: 1,
+            severity: 1,
+            previous_severity: 0,
+            sensor: name_field("s"),
+            axis: name_field("radial"),
+        }
+    }
+
+    fn settings(test: &str) -> AlertServiceSettings {
+        let root = scratch_dir(test).join("iox");
+        AlertServiceSettings {
+            service: "bearingd/alerts".into(),
+            iox: IoxSettings {
+                prefix: Some(format!("bdunit{}_{test}_", std::process::id())),
+                root_path: Some(root.display().to_string()),
+            },
+        }
+    }
+
+    fn drain(subscriber: &mut AlertSubscriber) -> Vec<Received> {
+        let mut all = Vec::new();
+        while let Some(r) = subscriber.next(Duration::from_millis(300)) {
+            all.push(r);
+        }
+        all
+    }
+
+    #[test]
+    fn a_subscriber_that_falls_behind_is_told_which_alerts_it_lost() {
+        let settings = settings("lost");
+        let publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
+        let mut subscriber = AlertSubscriber::open(&settings).unwrap();
+        assert!(subscriber.take_history(Duration::from_millis(300)).is_empty());
+        let total = SUBSCRIBER_BUFFER as u64 + 44;
+        for sequence in 1..=total {
+            publisher.send(alert(sequence));
+            if sequence % 64 == 0 {
+                std::thread::sleep(Duration::from_millis(20)); // let the thread keep up
+            }
+        }
+        let summary = publisher.finish();
+        assert_eq!(summary.published, total);
+        assert_eq!(summary.dropped, 0);
+        let received = drain(&mut subscriber);
+        // The buffer kept the newest alerts; the oldest were overwritten and are reported.
+        assert_eq!(
+            received.first(),
+            Some(&Received::Lost {
+                run_id: 42,
+                first: 1,
+                last: 44
+            })
+        );
+        let sequences: Vec<u64> = received[1..]
+            .iter()
+            .map(|r| match r {
+                Received::Alert(a) => a.sequence,
+                other => panic!("unexpected {other:?}"),
+            })
+            .collect();
+        assert_eq!(sequences, (45..=total).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_late_subscriber_receives_the_history_then_live_alerts_and_restarts() {
+        let settings = settings("history");
+        let publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
+        for sequence in 1..=20 {
+            publisher.send(alert(sequence));
+        }
+        std::thread::sleep(Duration::from_millis(200));
+        let mut subscriber = AlertSubscriber::open(&settings).unwrap();
+        let history = subscriber.take_history(Duration::from_millis(500));
+        let sequences: Vec<u64> = history
+            .iter()
+            .filter_map(|r| match r {
+                Received::Alert(a) => Some(a.sequence),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(sequences, (5..=20).collect::<Vec<_>>(), "{history:?}");
+        publisher.send(alert(21));
+        assert_eq!(
+            subscriber.next(Duration::from_secs(5)),
+            Some(Received::Alert(alert(21)))
+        );
+        // The daemon restarts: a new run id, numbers from 1 again.
+        publisher.finish();
+        let publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
+        let restarted = Alert {
+            run_id: 43,
+            ..alert(1)
+        };
+        publisher.send(restarted);
+        assert_eq!(
+            subscriber.next(Duration::from_secs(5)),
+            Some(Received::NewRun { run_id: 43 })
+        );
+        assert_eq!(
+            subscriber.next(Duration::from_secs(5)),
+            Some(Received::Alert(restarted))
+        );
+        publisher.finish();
     }
 }

@@ -72,10 +72,7 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
     let mut subscriber = open_when_available(&settings, &left)?;
     // The history: the alerts active when we subscribed.
     let mut active: BTreeMap<(String, String, u8), Alert> = BTreeMap::new();
-    let history_end = Instant::now() + HISTORY_WAIT;
-    while let Some(received) =
-        subscriber.next(history_end.saturating_duration_since(Instant::now()))
-    {
+    for received in subscriber.take_history(HISTORY_WAIT) {
         match received {
             Received::Alert(alert) => {
                 let Ok(view) = alert.view() else {

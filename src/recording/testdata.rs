@@ -84,19 +84,34 @@ pub fn read_manifest(dir: &Path) -> Vec<std::collections::HashMap<String, String
         .collect()
 }
 
-/// The project's Python with the MCAP readers (`.venv/bin/python`, made by `.ci/run`). Under
-/// `CI=true` a missing venv or package fails the test and says what is missing.
+/// The project's Python (`.venv/bin/python`) with the MCAP reader packages, for the
+/// independent check of our files; `None` (said on stderr) outside CI when it is missing.
 ///
 /// # Panics
-/// Under CI when the readers are missing (tests only).
+/// Under `CI=true` when it is missing (tests only).
 pub fn python_mcap() -> Option<PathBuf> {
+    venv_python(
+        "import mcap, mcap_protobuf, google.protobuf",
+        "the Python MCAP reader (mcap, mcap-protobuf-support, protobuf)",
+    )
+}
+
+/// The project's Python with the `iceoryx2` package, for the Python alert subscriber.
+///
+/// # Panics
+/// Under `CI=true` when it is missing (tests only).
+pub fn python_iceoryx2() -> Option<PathBuf> {
+    venv_python("import iceoryx2", "the Python iceoryx2 package")
+}
+
+fn venv_python(imports: &str, what: &str) -> Option<PathBuf> {
     let py = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
     let ci = std::env::var("CI").is_ok_and(|v| v == "true");
     let problem = if !py.exists() {
         Some(format!("{} does not exist", py.display()))
     } else {
         let out = std::process::Command::new(&py)
-            .args(["-c", "import mcap, mcap_protobuf, google.protobuf"])
+            .args(["-c", imports])
             .output()
             .expect("run python");
         (!out.status.success()).then(|| String::from_utf8_lossy(&out.stderr).into_owned())
@@ -104,11 +119,11 @@ pub fn python_mcap() -> Option<PathBuf> {
     match problem {
         None => Some(py),
         Some(p) if ci => panic!(
-            "Python MCAP reader missing ({p}); create it with `python3 -m venv .venv && \
-             .venv/bin/pip install -r scripts/requirements-ci.txt` (mcap, mcap-protobuf-support, protobuf)"
+            "{what} missing ({p}); create it with `python3 -m venv .venv && \
+             .venv/bin/pip install -r scripts/requirements-ci.txt`"
         ),
         Some(p) => {
-            eprintln!("skipping the Python check: {p}");
+            eprintln!("skipping the Python check: {what} missing: {p}");
             None
         }
     }

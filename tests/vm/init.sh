@@ -5,6 +5,8 @@
 export PATH=/bin
 mount -t proc proc /proc; mount -t sysfs sysfs /sys; mount -t devtmpfs devtmpfs /dev
 mount -t tmpfs tmpfs /tmp
+# iceoryx2 (bearingd run's alert service) keeps its shared memory in /dev/shm.
+mkdir -p /dev/shm; mount -t tmpfs tmpfs /dev/shm
 echo "INIT: userspace up at $(cut -d' ' -f1 /proc/uptime)s kernel $(uname -r)"
 for m in can can-raw can-dev vcan; do insmod /lib/modules/$m.ko || echo "INIT: insmod $m FAILED"; done
 firmware-sim --transport can --interface vcan0 --create-vcan --duration 0 || echo "INIT: vcan0 FAILED"
