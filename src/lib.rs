@@ -22,6 +22,7 @@
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
 
+pub mod alerts;
 pub mod analysis;
 pub mod bearing;
 pub mod cli;

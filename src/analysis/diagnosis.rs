@@ -62,6 +62,22 @@ pub struct Diagnosis {
     pub reason: String,
 }
 
+/// How far a fault's `score` is from the decision boundary, in log units (positive: a fault),
+/// and the confidence that gives, in [0.5, 1]. Both conditions (`score ≥ min_fault_score`,
+/// `score ≥ min_score_ratio × runner_up`) must hold, so the weaker one counts.
+pub fn score_evidence(
+    score: f64,
+    runner_up: f64,
+    min_fault_score: f64,
+    min_score_ratio: f64,
+) -> (f64, f64) {
+    let ratio = score / runner_up.max(1e-9);
+    let evidence = (score.max(1e-9) / min_fault_score)
+        .ln()
+        .min((ratio / min_score_ratio).ln());
+    (evidence, 1.0 - 0.5 * (-2.0 * evidence.abs()).exp())
+}
+
 /// Decides from the scores of every fault kind.
 pub fn diagnose(scores: &[FaultScore], min_fault_score: f64, min_score_ratio: f64) -> Diagnosis {
     let mut ranked: Vec<&FaultScore> = scores.iter().collect();
@@ -75,11 +91,8 @@ pub fn diagnose(scores: &[FaultScore], min_fault_score: f64, min_score_ratio: f6
     };
     let runner_up = ranked.get(1).map_or(1.0, |s| s.score.max(1e-9));
     let ratio = best.score / runner_up;
-    // Evidence in log units: both conditions must hold, so the weaker one counts.
-    let evidence = (best.score.max(1e-9) / min_fault_score)
-        .ln()
-        .min((ratio / min_score_ratio).ln());
-    let confidence = 1.0 - 0.5 * (-2.0 * evidence.abs()).exp();
+    let (evidence, confidence) =
+        score_evidence(best.score, runner_up, min_fault_score, min_score_ratio);
     let runner_name = ranked.get(1).map_or("none", |s| s.fault.name());
     if evidence >= 0.0 {
         Diagnosis {

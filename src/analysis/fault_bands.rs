@@ -12,7 +12,7 @@ use crate::bearing::FaultFrequencies;
 use serde::Serialize;
 
 /// The fault classes that have a characteristic frequency.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum FaultKind {
     OuterRace,
@@ -36,6 +36,11 @@ impl FaultKind {
             FaultKind::Ball => "ball",
             FaultKind::Cage => "cage",
         }
+    }
+
+    /// The kind whose [`name`](Self::name) is `name`.
+    pub fn from_name(name: &str) -> Option<FaultKind> {
+        FaultKind::ALL.into_iter().find(|f| f.name() == name)
     }
 
     /// The short label engineers use for the frequency: BPFO, BPFI, 2BSF (twice the ball spin frequency), FTF.

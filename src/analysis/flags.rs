@@ -24,6 +24,13 @@ impl FlagLevel {
             FlagLevel::Alarm => "alarm",
         }
     }
+
+    /// The level whose [`name`](Self::name) is `name`.
+    pub fn from_name(name: &str) -> Option<FlagLevel> {
+        [FlagLevel::Ok, FlagLevel::Watch, FlagLevel::Alarm]
+            .into_iter()
+            .find(|l| l.name() == name)
+    }
 }
 
 /// Thresholds and delays of a flag, delays already in samples.

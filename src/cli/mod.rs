@@ -5,6 +5,8 @@
 //! Exit codes: 0 success, 2 bad input (a file, an option or a config that cannot be used; the
 //! message names it and says how to fix it), 1 anything else.
 
+#[cfg(feature = "shm")]
+mod alerts;
 mod analyze;
 mod config_cmd;
 mod import;
@@ -100,6 +102,9 @@ enum Command {
     },
     /// Run one source (SocketCAN or iceoryx2) alone and report what arrived.
     Ingest(ingest::IngestArgs),
+    /// Print the daemon's active alerts, then each alert as it comes (iceoryx2).
+    #[cfg(feature = "shm")]
+    Alerts(alerts::AlertsArgs),
     /// Configuration helpers.
     Config {
         #[command(subcommand)]
@@ -119,6 +124,8 @@ pub fn main() -> ExitCode {
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),
+        #[cfg(feature = "shm")]
+        Command::Alerts(args) => alerts::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -6,7 +6,7 @@ use crate::config::{self, Config};
 use crate::daemon::messages::PipelineMessage;
 use crate::daemon::run::{run, status_line, RunOptions, Sink};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct RunArgs {
@@ -77,8 +77,19 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         .block_on(run(config, options, sinks, shutdown_signal()))
         .map_err(CliError::input)?;
     println!(
-        "summary: {} messages, {} twin fits ({} skipped while busy)",
-        summary.messages, summary.twin_fits, summary.twin_requests_skipped
+        "summary: {} messages, {} twin fits ({} skipped while busy), {} alerts published{}",
+        summary.messages,
+        summary.twin_fits,
+        summary.twin_requests_skipped,
+        summary.alerts_published,
+        if summary.alerts_dropped > 0 {
+            format!(
+                " ({} DROPPED: the alert queue was full)",
+                summary.alerts_dropped
+            )
+        } else {
+            String::new()
+        }
     );
     for channel in &summary.channels {
         println!("  {}", status_line(channel));
@@ -93,13 +104,8 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
 }
 
 fn embedded_default(args: &RunArgs) -> Result<Config, CliError> {
-    let mut config = Config::default_embedded().map_err(CliError::failure)?;
-    let data = args
-        .data_dir
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("bearingd-data"));
-    config.outputs.state_dir = data.join("state");
-    config.outputs.mcap_dir = data.join("mcap");
+    let config = embedded_config(args.data_dir.as_deref())?;
+    let data = data_dir(args.data_dir.as_deref());
     eprintln!(
         "bearingd: no --config: running the embedded default (a simulated sensor on an SKF 6205-2RS that develops an outer-race fault after 30 s); state and logs in {}",
         data.display()
@@ -124,4 +130,27 @@ async fn shutdown_signal() {
     }
     #[cfg(not(unix))]
     let _ = ctrl_c.await;
+}
+
+/// The data directory of a run without a config: `--data-dir`, or `./bearingd-data`.
+fn data_dir(given: Option<&Path>) -> PathBuf {
+    given.map_or_else(|| PathBuf::from("bearingd-data"), Path::to_path_buf)
+}
+
+/// The embedded default config with its files under the data directory: state, MCAP logs and
+/// the iceoryx2 root (so that a user without root can run it; `bearingd alerts --data-dir`
+/// finds the same root).
+pub(super) fn embedded_config(data_dir_arg: Option<&Path>) -> Result<Config, CliError> {
+    let mut config = Config::default_embedded().map_err(CliError::failure)?;
+    let data = data_dir(data_dir_arg);
+    let absolute = std::path::absolute(&data).map_err(|e| {
+        CliError::input(format!(
+            "{}: cannot make the data directory absolute: {e}; give --data-dir as an absolute path",
+            data.display()
+        ))
+    })?;
+    config.outputs.state_dir = data.join("state");
+    config.outputs.mcap_dir = data.join("mcap");
+    config.outputs.iceoryx2_root = absolute.join("iceoryx2");
+    Ok(config)
 }

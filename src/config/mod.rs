@@ -59,6 +59,7 @@ pub use types::{
     CanConfig, Config, OutputConfig, SensorConfig, ShmConfig, SimConfig, SimFault, Speed,
     ThresholdConfig, Transport, TwinConfig,
 };
+pub use validate::MAX_ID_LEN;
 
 /// The embedded default configuration: one simulated sensor on an SKF 6205-2RS at 1772 rpm,
 /// sampled at 25.6 kHz, whose outer race develops a fault after 30 s. Also the documented

@@ -22,7 +22,7 @@ use super::types::{
 };
 
 /// Longest sensor id, in characters.
-const MAX_ID_LEN: usize = 32;
+pub const MAX_ID_LEN: usize = 32;
 /// Longest iceoryx2 service name we accept, in bytes.
 const MAX_SERVICE_LEN: usize = 255;
 /// The kernel's IFNAMSIZ (16) less the terminating NUL.

@@ -5,22 +5,32 @@
 //! - async (tokio): sources, signals, status lines. Sources send into the analysis queue and
 //!   wait when it is full (`Block`): an in-process source is simply slowed; a transport source
 //!   then backs up into its own buffer, where a loss shows as an exact sequence gap.
-//! - analysis thread: the [`Pipeline`]; hands messages to the sink queue (`Block`) and twin
-//!   requests to the re-fit queue (`DropNewest`: a request that finds the re-fit thread busy is
-//!   skipped and counted; the next period brings a fresh one).
-//! - re-fit thread: [`TwinWorker`]; its results go to the sink queue.
+//! - analysis thread: the [`Pipeline`]; hands messages to the sink queue (`Block`), flag changes
+//!   as alerts to the alert queue (`DropNewest`, counted and reported; alerts are rare), and
+//!   twin requests to the re-fit queue (`DropNewest`: a request that finds the re-fit thread
+//!   busy is skipped and counted; the next period brings a fresh one). It stamps each input
+//!   with the wall clock when it takes it, for the alerts' latency; analysis never sees it.
+//! - alert thread: the iceoryx2 publisher of `outputs.alerts_service` ([`crate::alerts`]).
+//!   Alerts skip the sink queue so that MCAP compression never delays them.
+//! - re-fit thread: [`TwinWorker`]; its results go to the sink queue, and back to the analysis
+//!   thread (status, alert confidence) through a hand-over list that holds at most the fits of
+//!   one request per channel.
 //! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
 //!   them at shutdown happens there.
 
 use super::live_source::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
 use super::mcap_sink::McapSink;
-use super::messages::{ChannelId, FlagMessage, PipelineMessage};
+use super::messages::{FlagMessage, PipelineMessage, TwinMessage};
 use super::notify::{keep_alive, Notifier};
 use super::pipeline::{ChannelStatus, Input, Output, Pipeline, TwinRequest};
 use super::sim_source::SimSource;
 use super::twin_worker::TwinWorker;
+#[cfg(feature = "shm")]
+use crate::alerts::tracker::history_size_for;
+use crate::alerts::tracker::AlertTracker;
 use crate::analysis::health::Baseline;
 use crate::config::{Config, Transport};
+use crate::daemon::messages::ChannelId;
 use crate::mcap_log::{wall_clock_now_ns, LoggerConfig};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -50,6 +60,8 @@ pub enum RunError {
     },
     #[error("MCAP log: {0}")]
     Log(String),
+    #[error("alerts: {0}")]
+    Alerts(String),
     #[error("{what} thread failed: {detail}")]
     Thread { what: &'static str, detail: String },
 }
@@ -62,6 +74,10 @@ pub struct RunSummary {
     pub messages: u64,
     pub twin_fits: u64,
     pub twin_requests_skipped: u64,
+    /// Alerts published on the iceoryx2 alert service.
+    pub alerts_published: u64,
+    /// Alerts that found the alert queue full (reported as they happen).
+    pub alerts_dropped: u64,
 }
 
 /// A consumer of pipeline messages on the sink thread.
@@ -123,7 +139,9 @@ pub async fn run(
     let baselines = load_baselines(&state_dir);
     let pipeline = Pipeline::new(&config, &baselines);
     let status_board = Arc::new(Mutex::new(pipeline.status()));
-    let twin_board: Arc<Mutex<BTreeMap<ChannelId, (String, f64)>>> = Arc::default();
+    // Fits made on the re-fit thread, waiting for the analysis thread to take them.
+    let fresh_twins: Arc<Mutex<Vec<TwinMessage>>> = Arc::default();
+    let alerts = start_alerts(&config)?;
     let skipped = Arc::new(AtomicU64::new(0));
     // Liveness for systemd's watchdog: the analysis thread bumps it after every input, the
     // notify task reads it. An atomic, not the status board, because it must advance even when
@@ -138,7 +156,7 @@ pub async fn run(
     let analysis = {
         let sink_tx = sink_tx.clone();
         let status_board = status_board.clone();
-        let twin_board = twin_board.clone();
+        let fresh_twins = fresh_twins.clone();
         let skipped = skipped.clone();
         let heartbeat = heartbeat.clone();
         let state_dir = state_dir.clone();
@@ -146,9 +164,14 @@ pub async fn run(
             .name("bearingd-analysis".into())
             .spawn(move || {
                 let mut pipeline = pipeline;
+                let mut alerts = alerts;
                 while let Some(input) = input_rx.blocking_recv() {
+                    let taken_ns = wall_clock_now_ns();
                     pipeline.handle(input, &mut |output| match output {
                         Output::Message(m) => {
+                            if let Some((tracker, publisher)) = alerts.as_mut() {
+                                tracker.observe(&m, taken_ns, &mut |a| publisher.send(a));
+                            }
                             let _ = sink_tx.send(m);
                         }
                         Output::Twin(request) => {
@@ -157,9 +180,14 @@ pub async fn run(
                             }
                         }
                     });
-                    if let Ok(twins) = twin_board.lock() {
-                        for (channel, (hypothesis, error)) in twins.iter() {
-                            pipeline.note_twin(channel, hypothesis, *error);
+                    let fits = fresh_twins
+                        .lock()
+                        .map(|mut f| std::mem::take(&mut *f))
+                        .unwrap_or_default();
+                    for fit in &fits {
+                        pipeline.note_twin(&fit.channel, &fit.hypothesis, fit.error);
+                        if let Some((tracker, _)) = alerts.as_mut() {
+                            tracker.note_twin(fit);
                         }
                     }
                     if let Ok(mut board) = status_board.lock() {
@@ -171,6 +199,7 @@ pub async fn run(
                 for (channel, blocks) in pipeline.unknown_channels() {
                     eprintln!("bearingd: {blocks} blocks of {channel} skipped: no such sensor/axis in the config");
                 }
+                alerts.map(|(_, publisher)| publisher.finish())
             })
             .map_err(|e| RunError::Thread {
                 what: "analysis",
@@ -180,7 +209,7 @@ pub async fn run(
     // The twin's re-fit thread.
     let refit = {
         let sink_tx = sink_tx.clone();
-        let twin_board = twin_board.clone();
+        let fresh_twins = fresh_twins.clone();
         std::thread::Builder::new()
             .name("bearingd-twin".into())
             .spawn(move || {
@@ -188,11 +217,13 @@ pub async fn run(
                 let mut fits = 0u64;
                 while let Ok(request) = twin_rx.recv() {
                     if let Some(message) = worker.refit(&request) {
-                        if let Ok(mut board) = twin_board.lock() {
-                            board.insert(
-                                message.channel.clone(),
-                                (message.hypothesis.clone(), message.error),
-                            );
+                        if let Ok(mut fresh) = fresh_twins.lock() {
+                            // At most one pending fit per channel: a newer one replaces it.
+                            fresh.retain(|f| f.channel != message.channel);
+                            fresh.push(TwinMessage {
+                                residual: Vec::new(),
+                                ..message.clone()
+                            });
                         }
                         fits += 1;
                         let _ = sink_tx.send(PipelineMessage::Twin(message));
@@ -304,7 +335,7 @@ pub async fn run(
     }
     // Dropping the sources' sender (inside `feed`) ends the analysis thread, which ends the
     // re-fit thread, which ends the sink thread.
-    analysis.join().map_err(|_| RunError::Thread {
+    let alert_summary = analysis.join().map_err(|_| RunError::Thread {
         what: "analysis",
         detail: "panicked".into(),
     })?;
@@ -329,7 +360,60 @@ pub async fn run(
         messages,
         twin_fits,
         twin_requests_skipped: skipped.load(Ordering::Relaxed),
+        alerts_published: alert_summary.map_or(0, |s| s.published),
+        alerts_dropped: alert_summary.map_or(0, |s| s.dropped),
     })
+}
+
+/// The alert service's publisher and the tracker that feeds it.
+#[cfg(feature = "shm")]
+type Alerts = (AlertTracker, crate::alerts::service::AlertPublisher);
+
+/// Creates the alert service `outputs.alerts_service` under `outputs.iceoryx2_root` (the file
+/// prefix from `$BEARINGD_IOX_PREFIX`, for isolated tests) and the tracker.
+#[cfg(feature = "shm")]
+fn start_alerts(config: &Config) -> Result<Option<Alerts>, RunError> {
+    use crate::alerts::service::{AlertPublisher, AlertServiceSettings};
+    use crate::ingest::shm::IoxSettings;
+    let channels: usize = config.sensors.iter().map(|s| s.axes.len()).sum();
+    let history = history_size_for(channels);
+    let settings = AlertServiceSettings {
+        service: config.outputs.alerts_service.clone(),
+        iox: IoxSettings {
+            prefix: std::env::var("BEARINGD_IOX_PREFIX").ok(),
+            root_path: Some(config.outputs.iceoryx2_root.display().to_string()),
+        },
+    };
+    let publisher =
+        AlertPublisher::start(settings, history).map_err(|e| RunError::Alerts(e.to_string()))?;
+    let rates = config
+        .sensors
+        .iter()
+        .map(|s| (s.id.clone(), s.sample_rate_hz))
+        .collect();
+    let tracker = AlertTracker::new(wall_clock_now_ns(), history, &config.analysis, rates);
+    Ok(Some((tracker, publisher)))
+}
+
+/// Without iceoryx2 (the `shm` feature) there is no alert service; flags still go to the log.
+#[cfg(not(feature = "shm"))]
+type Alerts = (AlertTracker, NoPublisher);
+
+#[cfg(not(feature = "shm"))]
+struct NoPublisher;
+
+#[cfg(not(feature = "shm"))]
+impl NoPublisher {
+    fn send(&self, _: crate::alerts::Alert) {}
+    fn finish(self) -> crate::alerts::PublisherSummary {
+        crate::alerts::PublisherSummary::default()
+    }
+}
+
+#[cfg(not(feature = "shm"))]
+fn start_alerts(_config: &Config) -> Result<Option<Alerts>, RunError> {
+    eprintln!("bearingd: built without the `shm` feature: no iceoryx2 alerts are published");
+    Ok(None)
 }
 
 /// Starts the SocketCAN and iceoryx2 sources of the config; `true` if there is any.

@@ -244,6 +244,18 @@ fn time_residual(
     }
 }
 
+/// The confidence of a fault found by the band scores once the twin has a say: its best fit
+/// agreeing raises it toward 1, disagreeing lowers it toward 0.5, each in proportion to how
+/// decisive the twin is (a `margin` of 0.1 in error or more counts fully).
+pub fn twin_adjusted_confidence(confidence: f64, twin_agrees: bool, margin: f64) -> f64 {
+    let weight = (margin / 0.1).clamp(0.0, 1.0);
+    if twin_agrees {
+        confidence + (1.0 - confidence) * 0.5 * weight
+    } else {
+        confidence - (confidence - 0.5) * weight
+    }
+}
+
 /// How the twin changes the verdict of the band scores.
 ///
 /// (choice) The band scores decide and the twin adjusts the confidence. The scores are
@@ -254,8 +266,6 @@ fn time_residual(
 /// scores see none is reported but raises no fault.
 pub fn combine(scores: &Diagnosis, twin: &TwinDiagnosis) -> (Diagnosis, bool, String) {
     let twin_fault = twin.best_fit().fault;
-    // How decisive the twin is: a margin of 0.1 in error or more counts fully.
-    let weight = (twin.margin / 0.1).clamp(0.0, 1.0);
     let mut combined = scores.clone();
     let (agrees, note) = match scores.verdict {
         Verdict::None => (
@@ -268,11 +278,11 @@ pub fn combine(scores: &Diagnosis, twin: &TwinDiagnosis) -> (Diagnosis, bool, St
             ),
         ),
         verdict if verdict.fault() == Some(twin_fault) => {
-            combined.confidence = scores.confidence + (1.0 - scores.confidence) * 0.5 * weight;
+            combined.confidence = twin_adjusted_confidence(scores.confidence, true, twin.margin);
             (true, format!("the twin agrees: {} fits best (error {:.3}, margin {:.3})", twin_fault.name(), twin.best_fit().error, twin.margin))
         }
         verdict => {
-            combined.confidence = scores.confidence - (scores.confidence - 0.5) * weight;
+            combined.confidence = twin_adjusted_confidence(scores.confidence, false, twin.margin);
             (
                 false,
                 format!(

@@ -1,0 +1,308 @@
+//! The iceoryx2 ends of the alert service: the daemon's publisher (on a thread of its own,
+//! fed through a bounded channel) and the subscriber that `bearingd alerts` and the tests use.
+//!
+//! Service shape (the publisher creates it; subscribers only open it, so a subscriber started
+//! first cannot create it with a shape the daemon would then refuse):
+//! - publish-subscribe `<alerts_service>` with payload [`Alert`], a history of
+//!   [`history_size_for`](super::tracker::history_size_for) the daemon's channels (a late
+//!   subscriber receives the active alerts), a subscriber buffer of [`SUBSCRIBER_BUFFER`]
+//!   alerts, and safe overflow: a subscriber that does not keep up loses its oldest alerts,
+//!   never the newest, and sees the loss as a gap in `sequence` ([`Received::Lost`]);
+//! - event `<alerts_service>/wake`, notified after every alert, so a subscriber sleeps in the
+//!   kernel instead of polling.
+//!
+//! iceoryx2 hands history to a new subscriber when the publisher next updates its
+//! connections; the publisher thread does that every [`CONNECTION_PERIOD`] while idle.
+
+use super::payload::Alert;
+use super::PublisherSummary;
+use crate::ingest::shm::{create_node, open_event_service, IoxSettings};
+use iceoryx2::port::update_connections::UpdateConnections;
+use iceoryx2::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::mpsc;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// Alerts a subscriber's buffer holds before the oldest is overwritten.
+pub const SUBSCRIBER_BUFFER: usize = 256;
+/// How often an idle publisher looks for new subscribers (to hand them the history).
+pub const CONNECTION_PERIOD: Duration = Duration::from_millis(50);
+/// Alerts waiting between the analysis thread and the publisher thread.
+const QUEUE: usize = 256;
+
+/// Why the alert service could not be used. Messages name the service and the root path.
+#[derive(Debug, thiserror::Error)]
+pub enum AlertError {
+    #[error("alert service {service}: {detail}")]
+    Service { service: String, detail: String },
+    #[error("alert publisher thread: {0}")]
+    Thread(String),
+}
+
+/// Where the alert service is.
+#[derive(Debug, Clone)]
+pub struct AlertServiceSettings {
+    /// The publish-subscribe service name (`outputs.alerts_service`).
+    pub service: String,
+    pub iox: IoxSettings,
+}
+
+impl AlertServiceSettings {
+    fn wake_name(&self) -> String {
+        format!("{}/wake", self.service)
+    }
+
+    fn error(&self, detail: impl Into<String>) -> AlertError {
+        let root = self
+            .iox
+            .root_path
+            .as_deref()
+            .unwrap_or("iceoryx2's default");
+        AlertError::Service {
+            service: self.service.clone(),
+            detail: format!("{} (iceoryx2 root {root})", detail.into()),
+        }
+    }
+
+    fn service_name(&self) -> Result<ServiceName, AlertError> {
+        ServiceName::new(&self.service).map_err(|e| self.error(format!("invalid name: {e:?}")))
+    }
+}
+
+/// The daemon's side: hand alerts to [`send`](Self::send); a thread publishes them.
+pub struct AlertPublisher {
+    queue: mpsc::SyncSender<Alert>,
+    dropped: Arc<AtomicU64>,
+    thread: std::thread::JoinHandle<u64>,
+}
+
+impl AlertPublisher {
+    /// Creates the services and the publisher on a new thread; returns once they exist, or
+    /// with the reason they could not be created.
+    pub fn start(
+        settings: AlertServiceSettings,
+        history_size: usize,
+    ) -> Result<AlertPublisher, AlertError> {
+        let (queue, alerts) = mpsc::sync_channel::<Alert>(QUEUE);
+        let (started_tx, started_rx) = mpsc::sync_channel::<Result<(), AlertError>>(1);
+        let thread = std::thread::Builder::new()
+            .name("bearingd-alerts".into())
+            .spawn(move || publisher_thread(&settings, history_size, &alerts, &started_tx))
+            .map_err(|e| AlertError::Thread(e.to_string()))?;
+        match started_rx.recv() {
+            Ok(Ok(())) => Ok(AlertPublisher {
+                queue,
+                dropped: Arc::default(),
+                thread,
+            }),
+            Ok(Err(e)) => {
+                let _ = thread.join();
+                Err(e)
+            }
+            Err(_) => {
+                let _ = thread.join();
+                Err(AlertError::Thread("ended before its ports existed".into()))
+            }
+        }
+    }
+
+    /// Queues one alert for publishing; a full queue counts the alert as dropped and says so.
+    pub fn send(&self, alert: Alert) {
+        if self.queue.try_send(alert).is_err() {
+            let dropped = self.dropped.fetch_add(1, Ordering::Relaxed) + 1;
+            eprintln!(
+                "bearingd: alert #{} not published: the alert queue is full ({dropped} dropped so far)",
+                alert.sequence
+            );
+        }
+    }
+
+    /// Publishes what is queued, closes the ports and reports.
+    pub fn finish(self) -> PublisherSummary {
+        drop(self.queue);
+        let published = self.thread.join().unwrap_or(0);
+        PublisherSummary {
+            published,
+            dropped: self.dropped.load(Ordering::Relaxed),
+        }
+    }
+}
+
+fn publisher_thread(
+    settings: &AlertServiceSettings,
+    history_size: usize,
+    alerts: &mpsc::Receiver<Alert>,
+    started: &mpsc::SyncSender<Result<(), AlertError>>,
+) -> u64 {
+    let setup = (|| {
+        let node = create_node(&settings.iox).map_err(|e| settings.error(e.to_string()))?;
+        let service = node
+            .service_builder(&settings.service_name()?)
+            .publish_subscribe::<Alert>()
+            .history_size(history_size)
+            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER.max(history_size))
+            .enable_safe_overflow(true)
+            .max_publishers(2)
+            .max_subscribers(16)
+            .open_or_create()
+            .map_err(|e| {
+                settings.error(format!(
+                    "open or create: {e:?}; if another bearingd uses this service name, give \
+                     each its own outputs.alerts_service"
+                ))
+            })?;
+        let publisher = service
+            .publisher_builder()
+            .create()
+            .map_err(|e| settings.error(format!("create publisher: {e:?}")))?;
+        let wake = open_event_service(&node, &settings.wake_name())
+            .map_err(|e| settings.error(e.to_string()))?
+            .notifier_builder()
+            .create()
+            .map_err(|e| settings.error(format!("create notifier: {e:?}")))?;
+        Ok((node, service, publisher, wake))
+    })();
+    let (_node, _service, publisher, wake) = match setup {
+        Ok(ports) => {
+            let _ = started.send(Ok(()));
+            ports
+        }
+        Err(e) => {
+            let _ = started.send(Err(e));
+            return 0;
+        }
+    };
+    let mut published = 0u64;
+    loop {
+        match alerts.recv_timeout(CONNECTION_PERIOD) {
+            Ok(alert) => match publisher.send_copy(alert) {
+                Ok(_) => {
+                    published += 1;
+                    let _ = wake.notify();
+                }
+                Err(e) => eprintln!(
+                    "bearingd: alert #{} could not be published on {}: {e:?}",
+                    alert.sequence, settings.service
+                ),
+            },
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                let _ = publisher.update_connections();
+            }
+            Err(mpsc::RecvTimeoutError::Disconnected) => return published,
+        }
+    }
+}
+
+/// What a subscriber takes from the service.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Received {
+    Alert(Alert),
+    /// Alerts `first..=last` of the run never arrived: the subscriber's buffer overflowed.
+    Lost {
+        run_id: u64,
+        first: u64,
+        last: u64,
+    },
+    /// The daemon restarted (a new run id); sequence numbers start again.
+    NewRun {
+        run_id: u64,
+    },
+}
+
+/// The subscriber's side of the service.
+pub struct AlertSubscriber {
+    _node: Node<ipc::Service>,
+    subscriber: iceoryx2::port::subscriber::Subscriber<ipc::Service, Alert, ()>,
+    wake: iceoryx2::port::listener::Listener<ipc::Service>,
+    last: Option<(u64, u64)>,
+    pending: std::collections::VecDeque<Received>,
+    /// The service's history size: how many alerts a new subscriber is handed.
+    pub history_size: usize,
+}
+
+impl AlertSubscriber {
+    /// Opens the service; fails if the daemon has not created it (yet).
+    pub fn open(settings: &AlertServiceSettings) -> Result<AlertSubscriber, AlertError> {
+        let node = create_node(&settings.iox).map_err(|e| settings.error(e.to_string()))?;
+        let service = node
+            .service_builder(&settings.service_name()?)
+            .publish_subscribe::<Alert>()
+            .open()
+            .map_err(|e| {
+                settings.error(format!(
+                    "cannot open it ({e:?}): is bearingd running with this config? (the root \
+                     path and service name must be the daemon's)"
+                ))
+            })?;
+        let history_size = service.static_config().history_size();
+        let buffer = service.static_config().subscriber_max_buffer_size();
+        let subscriber = service
+            .subscriber_builder()
+            .buffer_size(buffer)
+            .history_request(history_size.min(buffer))
+            .create()
+            .map_err(|e| settings.error(format!("create subscriber: {e:?}")))?;
+        let wake = open_event_service(&node, &settings.wake_name())
+            .map_err(|e| settings.error(e.to_string()))?
+            .listener_builder()
+            .create()
+            .map_err(|e| settings.error(format!("create listener: {e:?}")))?;
+        Ok(AlertSubscriber {
+            _node: node,
+            subscriber,
+            wake,
+            last: None,
+            pending: Default::default(),
+            history_size,
+        })
+    }
+
+    /// The next alert (or loss, or restart), waiting at most `timeout`; `None` if nothing came.
+    pub fn next(&mut self, timeout: Duration) -> Option<Received> {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(received) = self.pending.pop_front() {
+                return Some(received);
+            }
+            self.drain();
+            if !self.pending.is_empty() {
+                continue;
+            }
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return None;
+            }
+            // Woken by the publisher; the timed wait bounds a missed wake-up.
+            let _ = self
+                .wake
+                .timed_wait(|_| {}, left.min(CONNECTION_PERIOD * 4));
+        }
+    }
+
+    fn drain(&mut self) {
+        while let Ok(Some(sample)) = self.subscriber.receive() {
+            let alert = *sample.payload();
+            match self.last {
+                Some((run, seq)) if run == alert.run_id => {
+                    if alert.sequence <= seq {
+                        continue; // already seen (history handed again)
+                    }
+                    if alert.sequence > seq + 1 {
+                        self.pending.push_back(Received::Lost {
+                            run_id: run,
+                            first: seq + 1,
+                            last: alert.sequence - 1,
+                        });
+                    }
+                }
+                Some(_) => self.pending.push_back(Received::NewRun {
+                    run_id: alert.run_id,
+                }),
+                None => {}
+            }
+            self.last = Some((alert.run_id, alert.sequence));
+            self.pending.push_back(Received::Alert(alert));
+        }
+    }
+}

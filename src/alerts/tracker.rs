@@ -1,0 +1,384 @@
+//! Turns the pipeline's flag changes into [`Alert`]s: state (raised, escalated, relaxed,
+//! cleared), confidence from the scores and the twin, a sequence number, and the bookkeeping
+//! that keeps every active alert inside the service's history.
+//!
+//! Sans-IO like the analysis: messages and the wall time in, alerts out, so the rules are
+//! tested without iceoryx2. Wall time is only stamped on alerts, never used to decide.
+//!
+//! Why "repeated" alerts: iceoryx2 keeps the last `history_size` samples for late subscribers.
+//! An alert raised long ago would fall out of that window after enough newer alerts (another
+//! channel flapping), and a subscriber connecting then would not know it is active. So when an
+//! active alert is about to leave the window it is sent again, unchanged, as `repeated`.
+
+use super::payload::{fault_code, name_field, severity_code, Alert, AlertState, ALERT_VERSION};
+use crate::analysis::diagnosis::score_evidence;
+use crate::analysis::fault_bands::FaultKind;
+use crate::analysis::flags::FlagLevel;
+use crate::analysis::AnalysisSettings;
+use crate::daemon::messages::{
+    ChannelId, FlagMessage, IndicatorsMessage, PipelineMessage, TwinMessage,
+};
+use crate::twin::diagnose::twin_adjusted_confidence;
+use std::collections::{BTreeMap, HashMap};
+
+/// What the tracker keeps of a channel's latest twin fit.
+#[derive(Debug, Clone, Copy)]
+struct TwinSummary {
+    best: Option<FaultKind>,
+    margin: f64,
+    /// Fit error per fault kind, in [`FaultKind::ALL`] order; NaN where the twin has no
+    /// hypothesis (cage).
+    errors: [f64; 4],
+}
+
+/// The alert state of every (channel, fault) and the numbering of one daemon run.
+pub struct AlertTracker {
+    run_id: u64,
+    sequence: u64,
+    history_size: u64,
+    min_fault_score: f64,
+    min_score_ratio: f64,
+    rates: HashMap<String, f64>,
+    /// Latest fault scores per channel, in [`FaultKind::ALL`] order.
+    scores: HashMap<ChannelId, [f64; 4]>,
+    twins: HashMap<ChannelId, TwinSummary>,
+    active: BTreeMap<AlertKey, Alert>,
+}
+
+/// One alert's identity: which channel, which fault.
+type AlertKey = (ChannelId, FaultKind);
+
+/// History an alert service needs for `channels` analysed channels: room for every fault of
+/// every channel to be active twice over, so repeats stay rare.
+pub fn history_size_for(channels: usize) -> usize {
+    (2 * FaultKind::ALL.len() * channels).max(16)
+}
+
+impl AlertTracker {
+    /// `run_id` identifies this daemon run in every alert; `rates` maps sensor ids to sample
+    /// rates; `history_size` is the alert service's.
+    pub fn new(
+        run_id: u64,
+        history_size: usize,
+        settings: &AnalysisSettings,
+        rates: HashMap<String, f64>,
+    ) -> AlertTracker {
+        AlertTracker {
+            run_id,
+            sequence: 0,
+            history_size: history_size.max(2) as u64,
+            min_fault_score: settings.min_fault_score,
+            min_score_ratio: settings.min_score_ratio,
+            rates,
+            scores: HashMap::new(),
+            twins: HashMap::new(),
+            active: BTreeMap::new(),
+        }
+    }
+
+    /// The alerts active now (their latest version), ordered by channel and fault.
+    pub fn active(&self) -> impl Iterator<Item = &Alert> {
+        self.active.values()
+    }
+
+    /// Takes one pipeline message; emits the alerts it causes through `publish`.
+    pub fn observe(
+        &mut self,
+        message: &PipelineMessage,
+        wall_time_ns: u64,
+        publish: &mut impl FnMut(Alert),
+    ) {
+        match message {
+            PipelineMessage::Indicators(m) => self.note_scores(m),
+            PipelineMessage::Twin(m) => self.note_twin(m),
+            PipelineMessage::Flag(flag) => {
+                if let Some((key, alert)) = self.alert_for(flag, wall_time_ns) {
+                    self.emit(key, alert, publish);
+                    self.keep_active_in_history(wall_time_ns, publish);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn note_scores(&mut self, m: &IndicatorsMessage) {
+        self.scores.insert(
+            m.channel.clone(),
+            [
+                m.score_outer_race,
+                m.score_inner_race,
+                m.score_ball,
+                m.score_cage,
+            ],
+        );
+    }
+
+    /// Takes a twin fit (also called by `run` for fits made on the re-fit thread).
+    pub fn note_twin(&mut self, m: &TwinMessage) {
+        self.twins.insert(
+            m.channel.clone(),
+            TwinSummary {
+                best: FaultKind::from_name(&m.hypothesis),
+                margin: m.margin,
+                errors: [
+                    m.error_outer_race,
+                    m.error_inner_race,
+                    m.error_ball,
+                    f64::NAN,
+                ],
+            },
+        );
+    }
+
+    fn alert_for(&self, flag: &FlagMessage, wall_time_ns: u64) -> Option<(AlertKey, Alert)> {
+        let fault = FaultKind::from_name(&flag.fault)?;
+        let from = FlagLevel::from_name(&flag.from)?;
+        let to = FlagLevel::from_name(&flag.to)?;
+        let state = AlertState::of_change(from, to);
+        let index = FaultKind::ALL.iter().position(|f| *f == fault)?;
+        let runner_up = self.scores.get(&flag.channel).map_or(1.0, |scores| {
+            scores
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != index)
+                .map(|(_, s)| *s)
+                .fold(1e-9, f64::max)
+        });
+        let (_, mut confidence) = score_evidence(
+            flag.score,
+            runner_up,
+            self.min_fault_score,
+            self.min_score_ratio,
+        );
+        let twin = self.twins.get(&flag.channel);
+        if let (Some(twin), true) = (twin, to != FlagLevel::Ok) {
+            if let Some(best) = twin.best {
+                confidence = twin_adjusted_confidence(confidence, best == fault, twin.margin);
+            }
+        }
+        let key = (flag.channel.clone(), fault);
+        Some((
+            key,
+            Alert {
+                sequence: 0,
+                run_id: self.run_id,
+                end_sample: flag.end_sample,
+                wall_time_ns,
+                sample_rate_hz: self
+                    .rates
+                    .get(&flag.channel.sensor)
+                    .copied()
+                    .unwrap_or(f64::NAN),
+                fault_frequency_hz: flag.fault_frequency_hz,
+                score: flag.score,
+                confidence,
+                twin_error: twin.map_or(f64::NAN, |t| t.errors[index]),
+                version: ALERT_VERSION,
+                state: state as u8,
+                fault: fault_code(fault),
+                severity: severity_code(to),
+                previous_severity: severity_code(from),
+                sensor: name_field(&flag.channel.sensor),
+                axis: name_field(&flag.channel.axis),
+            },
+        ))
+    }
+
+    fn emit(&mut self, key: AlertKey, mut alert: Alert, publish: &mut impl FnMut(Alert)) {
+        self.sequence += 1;
+        alert.sequence = self.sequence;
+        if alert.state == AlertState::Cleared as u8 {
+            self.active.remove(&key);
+        } else {
+            self.active.insert(key, alert);
+        }
+        publish(alert);
+    }
+
+    /// Re-sends the oldest active alerts that would otherwise leave the history window before
+    /// the next alert.
+    fn keep_active_in_history(&mut self, wall_time_ns: u64, publish: &mut impl FnMut(Alert)) {
+        for _ in 0..self.active.len() {
+            let room = self
+                .history_size
+                .saturating_sub(self.active.len() as u64)
+                .max(1);
+            let Some((key, oldest)) = self
+                .active
+                .iter()
+                .min_by_key(|(_, a)| a.sequence)
+                .map(|(k, a)| (k.clone(), *a))
+            else {
+                return;
+            };
+            if self.sequence - oldest.sequence < room {
+                return;
+            }
+            let repeat = Alert {
+                state: AlertState::Repeated as u8,
+                previous_severity: oldest.severity,
+                wall_time_ns,
+                ..oldest
+            };
+            self.emit(key, repeat, publish);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::alerts::payload::AlertState;
+
+    fn flag(axis: &str, fault: &str, from: &str, to: &str, at: u64) -> PipelineMessage {
+        PipelineMessage::Flag(FlagMessage {
+            channel: ChannelId {
+                sensor: "motor-de".into(),
+                axis: axis.into(),
+            },
+            end_sample: at,
+            fault: fault.into(),
+            from: from.into(),
+            to: to.into(),
+            score: 40.0,
+            fault_frequency_hz: 107.0,
+        })
+    }
+
+    fn tracker(history: usize) -> AlertTracker {
+        let rates = HashMap::from([("motor-de".to_string(), 25_600.0)]);
+        AlertTracker::new(99, history, &AnalysisSettings::default(), rates)
+    }
+
+    fn observe(t: &mut AlertTracker, m: &PipelineMessage) -> Vec<Alert> {
+        let mut out = Vec::new();
+        t.observe(m, 1, &mut |a| out.push(a));
+        out
+    }
+
+    #[test]
+    fn a_flag_cycle_gives_raised_escalated_relaxed_cleared_in_sequence() {
+        let mut t = tracker(16);
+        let steps = [
+            ("ok", "watch", AlertState::Raised),
+            ("watch", "alarm", AlertState::Escalated),
+            ("alarm", "watch", AlertState::Relaxed),
+            ("watch", "ok", AlertState::Cleared),
+        ];
+        for (j, (from, to, state)) in steps.into_iter().enumerate() {
+            let alerts = observe(
+                &mut t,
+                &flag("radial", "outer_race", from, to, 1000 * j as u64),
+            );
+            assert_eq!(alerts.len(), 1);
+            let view = alerts[0].view().unwrap();
+            assert_eq!(view.state, state);
+            assert_eq!(view.sequence, j as u64 + 1);
+            assert_eq!(view.run_id, 99);
+            assert_eq!(view.severity, to);
+            assert_eq!(view.previous_severity, from);
+            assert_eq!(view.fault, "outer_race");
+            assert_eq!(view.axis, "radial");
+            let active = t.active().count();
+            assert_eq!(active, usize::from(to != "ok"));
+        }
+    }
+
+    #[test]
+    fn confidence_rises_with_an_agreeing_twin_and_falls_with_a_disagreeing_one() {
+        let channel = ChannelId {
+            sensor: "motor-de".into(),
+            axis: "radial".into(),
+        };
+        let scores = PipelineMessage::Indicators(IndicatorsMessage {
+            channel: channel.clone(),
+            end_sample: 0,
+            rpm: 1797.0,
+            band_hz: [2000.0, 4000.0],
+            rms: 1.0,
+            peak: 3.0,
+            crest: 3.0,
+            kurtosis: 5.0,
+            score_outer_race: 40.0,
+            score_inner_race: 5.0,
+            score_ball: 4.0,
+            score_cage: 2.0,
+        });
+        let twin = |hypothesis: &str| TwinMessage {
+            channel: channel.clone(),
+            end_sample: 0,
+            hypothesis: hypothesis.into(),
+            error: 0.2,
+            margin: 0.2,
+            error_outer_race: 0.2,
+            error_inner_race: 0.4,
+            error_ball: 0.5,
+            a: 1.0,
+            decay_per_s: 1000.0,
+            f_n: 3000.0,
+            f_d: 107.0,
+            jitter: 0.01,
+            residual_energy_ratio: 0.1,
+            residual_peak_hz: 10.0,
+            residual_bin_hz: 1.0,
+            residual: vec![],
+        };
+        let raise = flag("radial", "outer_race", "ok", "watch", 10);
+        let mut plain = tracker(16);
+        observe(&mut plain, &scores);
+        let base = observe(&mut plain, &raise)[0];
+        assert!(base.twin_error.is_nan());
+        assert!(base.confidence > 0.5 && base.confidence < 1.0, "{base:?}");
+
+        let mut agreeing = tracker(16);
+        observe(&mut agreeing, &scores);
+        agreeing.note_twin(&twin("outer_race"));
+        let up = observe(&mut agreeing, &raise)[0];
+        assert!(up.confidence > base.confidence);
+        assert_eq!(up.twin_error, 0.2);
+
+        let mut disagreeing = tracker(16);
+        observe(&mut disagreeing, &scores);
+        disagreeing.note_twin(&twin("inner_race"));
+        let down = observe(&mut disagreeing, &raise)[0];
+        assert!(down.confidence < base.confidence);
+    }
+
+    #[test]
+    fn an_old_active_alert_is_repeated_before_it_leaves_the_history() {
+        let history = 16;
+        let mut t = tracker(history);
+        let mut all = observe(&mut t, &flag("x", "outer_race", "ok", "watch", 1));
+        // Another axis flaps for a long time.
+        for j in 0..40u64 {
+            let (from, to) = if j % 2 == 0 {
+                ("ok", "watch")
+            } else {
+                ("watch", "ok")
+            };
+            all.extend(observe(&mut t, &flag("y", "ball", from, to, 100 + j)));
+        }
+        let sequences: Vec<u64> = all.iter().map(|a| a.sequence).collect();
+        assert_eq!(sequences, (1..=all.len() as u64).collect::<Vec<_>>());
+        let repeats = all
+            .iter()
+            .filter(|a| a.state == AlertState::Repeated as u8)
+            .count();
+        assert!(repeats >= 2, "{repeats} repeats");
+        // After every alert, each active alert is among the last `history` sent.
+        let mut active: BTreeMap<(String, u8), u64> = BTreeMap::new();
+        for a in &all {
+            let view = a.view().unwrap();
+            let key = (view.axis.clone(), a.fault);
+            if view.state == AlertState::Cleared {
+                active.remove(&key);
+            } else {
+                active.insert(key, a.sequence);
+            }
+        }
+        let last = all.last().unwrap().sequence;
+        for (key, sequence) in &active {
+            assert!(last - sequence < history as u64, "{key:?} fell out");
+        }
+    }
+}

@@ -1,0 +1,226 @@
+//! `bearingd alerts`: prints the daemon's active alerts, then each alert as it comes.
+//!
+//! It finds the service the way the daemon does: from the daemon's config
+//! (`outputs.alerts_service` under `outputs.iceoryx2_root`), or, without one, from the
+//! embedded default's data directory (`bearingd run` without `--config`). Lost alerts (this
+//! subscriber fell behind) and daemon restarts are printed, never passed over.
+
+use super::run::embedded_config;
+use super::CliError;
+use crate::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
+use crate::alerts::{Alert, AlertState};
+use crate::config;
+use crate::ingest::shm::IoxSettings;
+use crate::mcap_log::wall_clock_now_ns;
+use clap::Args;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+#[derive(Args)]
+pub struct AlertsArgs {
+    /// The daemon's config file (for its alert service and iceoryx2 root); without it, those
+    /// of `bearingd run` without a config.
+    #[arg(long, conflicts_with = "data_dir")]
+    config: Option<PathBuf>,
+    /// The `--data-dir` of a `bearingd run` without a config (default ./bearingd-data).
+    #[arg(long)]
+    data_dir: Option<PathBuf>,
+    /// One JSON object per line instead of text.
+    #[arg(long)]
+    json: bool,
+    /// Exit after this many alerts (the active alerts printed at start count).
+    #[arg(long)]
+    count: Option<u64>,
+    /// Stop after this many seconds; with --count, an exit status of 1 if fewer came.
+    #[arg(long)]
+    timeout: Option<f64>,
+}
+
+/// How long history takes to arrive after subscribing: the daemon's publisher hands it over
+/// within its connection period (50 ms); this leaves room for a busy machine.
+const HISTORY_WAIT: Duration = Duration::from_millis(400);
+
+pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
+    let config = match &args.config {
+        Some(path) => config::load(path).map_err(CliError::input)?,
+        None => embedded_config(args.data_dir.as_deref())?,
+    };
+    let settings = AlertServiceSettings {
+        service: config.outputs.alerts_service.clone(),
+        iox: IoxSettings {
+            prefix: std::env::var("BEARINGD_IOX_PREFIX").ok(),
+            root_path: Some(config.outputs.iceoryx2_root.display().to_string()),
+        },
+    };
+    if let Some(t) = args.timeout {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(CliError::input(format!(
+                "--timeout {t}: give a number of seconds ≥ 0, e.g. --timeout 60"
+            )));
+        }
+    }
+    let deadline = args
+        .timeout
+        .map(|t| Instant::now() + Duration::from_secs_f64(t));
+    let left = || deadline.map(|d| d.saturating_duration_since(Instant::now()));
+    let mut printer = Printer {
+        json: args.json,
+        printed: 0,
+    };
+
+    let mut subscriber = open_when_available(&settings, &left)?;
+    // The history: the alerts active when we subscribed.
+    let mut active: BTreeMap<(String, String, u8), Alert> = BTreeMap::new();
+    let history_end = Instant::now() + HISTORY_WAIT;
+    while let Some(received) =
+        subscriber.next(history_end.saturating_duration_since(Instant::now()))
+    {
+        match received {
+            Received::Alert(alert) => {
+                let Ok(view) = alert.view() else {
+                    printer.problem(&alert);
+                    continue;
+                };
+                let key = (view.sensor, view.axis, alert.fault);
+                if view.state == AlertState::Cleared {
+                    active.remove(&key);
+                } else {
+                    active.insert(key, alert);
+                }
+            }
+            other => printer.event(&other),
+        }
+    }
+    if !args.json {
+        println!(
+            "{} active alert(s) on {} (history of {})",
+            active.len(),
+            settings.service,
+            subscriber.history_size
+        );
+    }
+    for alert in active.values() {
+        printer.alert(alert, true);
+        if printer.done(args.count) {
+            return Ok(());
+        }
+    }
+    loop {
+        let wait = left().unwrap_or(Duration::from_secs(3600));
+        if wait.is_zero() {
+            break;
+        }
+        match subscriber.next(wait) {
+            Some(Received::Alert(alert)) => {
+                printer.alert(&alert, false);
+                if printer.done(args.count) {
+                    return Ok(());
+                }
+            }
+            Some(other) => printer.event(&other),
+            None => {}
+        }
+    }
+    match args.count {
+        Some(count) => Err(CliError::failure(format!(
+            "{} of {count} alert(s) arrived within --timeout {} s",
+            printer.printed,
+            args.timeout.unwrap_or(0.0)
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// Opens the service, waiting for the daemon to create it (until the deadline, if any).
+fn open_when_available(
+    settings: &AlertServiceSettings,
+    left: &impl Fn() -> Option<Duration>,
+) -> Result<AlertSubscriber, CliError> {
+    let mut said = false;
+    loop {
+        match AlertSubscriber::open(settings) {
+            Ok(subscriber) => return Ok(subscriber),
+            Err(e) => {
+                if left().is_some_and(|l| l.is_zero()) {
+                    return Err(CliError::failure(e));
+                }
+                if !said {
+                    eprintln!("bearingd alerts: waiting for the daemon: {e}");
+                    said = true;
+                }
+                std::thread::sleep(
+                    left()
+                        .unwrap_or(Duration::from_secs(1))
+                        .min(Duration::from_millis(500)),
+                );
+            }
+        }
+    }
+}
+
+struct Printer {
+    json: bool,
+    printed: u64,
+}
+
+impl Printer {
+    fn done(&self, count: Option<u64>) -> bool {
+        count.is_some_and(|c| self.printed >= c)
+    }
+
+    fn alert(&mut self, alert: &Alert, active_at_start: bool) {
+        let Ok(view) = alert.view() else {
+            self.problem(alert);
+            return;
+        };
+        self.printed += 1;
+        if self.json {
+            let mut value = serde_json::to_value(&view).unwrap_or_default();
+            if let Some(object) = value.as_object_mut() {
+                object.insert("type".into(), "alert".into());
+                object.insert("active_at_start".into(), active_at_start.into());
+                object.insert("received_wall_ns".into(), wall_clock_now_ns().into());
+            }
+            println!("{value}");
+        } else {
+            let prefix = if active_at_start { "ACTIVE" } else { "ALERT " };
+            println!("{prefix} {}", view.line());
+        }
+    }
+
+    fn problem(&self, alert: &Alert) {
+        if let Err(e) = alert.view() {
+            eprintln!(
+                "bearingd alerts: cannot read alert #{}: {e}",
+                alert.sequence
+            );
+        }
+    }
+
+    fn event(&self, event: &Received) {
+        let (json, text) = match event {
+            Received::Lost {
+                run_id,
+                first,
+                last,
+            } => (
+                serde_json::json!({"type": "lost", "run_id": run_id, "first": first, "last": last}),
+                format!(
+                    "LOST alerts #{first}..#{last}: this subscriber fell behind and the daemon's \
+                     buffer overwrote them (see the MCAP log's /flags topics for what they were)"
+                ),
+            ),
+            Received::NewRun { run_id } => (
+                serde_json::json!({"type": "new_run", "run_id": run_id}),
+                format!("the daemon restarted (run {run_id}); alert numbers start again"),
+            ),
+            Received::Alert(_) => return,
+        };
+        if self.json {
+            println!("{json}");
+        } else {
+            eprintln!("bearingd alerts: {text}");
+        }
+    }
+}
