@@ -197,7 +197,7 @@ timeout 600 qemu-system-x86_64 -accel tcg -m 2048 -smp 2 \
 say "VM boot to power-off: $(( $(date +%s) - boot )) s (qemu exit $qemu_rc)"
 [ "$qemu_rc" = 0 ] || { say "qemu failed or timed out:"; cat "$WORK/qemu.log"; }
 tr -d '\r' < "$WORK/serial.log" > "$WORK/serial.txt"
-grep -a -E '^(PROBE|VMTEST|DIAG|ALERT)' "$WORK/serial.txt" || true
+grep -a -E '^(PROBE|VMTEST|VMINFO|DIAG|ALERT)' "$WORK/serial.txt" || true
 
 # 8. The MCAP file(s), from ttyS1, checked with the strict Python reader.
 rm -rf "$WORK/mcap"; mkdir -p "$WORK/mcap"
