@@ -144,3 +144,77 @@ fn run_without_notify_socket_is_unchanged() -> TestResult {
     assert!(!stderr.contains("notify"), "{stderr}");
     Ok(())
 }
+
+#[test]
+fn run_stops_cleanly_on_sigterm() -> TestResult {
+    // `systemctl stop` sends SIGTERM to a run without --duration. Regression: the simulated
+    // source ignored the stop and the run went on until systemd's SIGKILL, leaving an
+    // unfinished MCAP file. Expected: STOPPING=1, exit 0, the log finished (it ends with the
+    // MCAP magic, which only the finishing writer writes).
+    let dir = tempfile::tempdir()?;
+    let socket_path = dir.path().join("notify.sock");
+    let listener = UnixDatagram::bind(&socket_path)?;
+    listener.set_read_timeout(Some(Duration::from_millis(200)))?;
+    let config = write_config(dir.path())?;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .arg("run")
+        .arg("--config")
+        .arg(&config)
+        .arg("--quiet")
+        .env("NOTIFY_SOCKET", &socket_path)
+        .env_remove("WATCHDOG_USEC")
+        .stdout(Stdio::null())
+        .spawn()?;
+
+    // The first STATUS= after READY=1: the run is in its main loop, signals are handled.
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let mut messages: Vec<String> = Vec::new();
+    let mut buffer = [0u8; 4096];
+    while !messages.iter().any(|m| m.starts_with("STATUS=")) {
+        if let Ok(n) = listener.recv(&mut buffer) {
+            messages.push(String::from_utf8_lossy(&buffer[..n]).into_owned());
+        }
+        if Instant::now() > deadline || child.try_wait()?.is_some() {
+            let _ = child.kill();
+            child.wait()?;
+            return Err(format!("no STATUS= within 60 s, or an early exit: {messages:?}").into());
+        }
+    }
+    // SAFETY: kill(2) on our own child's pid; no memory involved.
+    let rc = unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGTERM) };
+    assert_eq!(rc, 0, "kill(SIGTERM) failed");
+    let stop_deadline = Instant::now() + Duration::from_secs(20);
+    let exit = loop {
+        if let Some(status) = child.try_wait()? {
+            break status;
+        }
+        if Instant::now() > stop_deadline {
+            child.kill()?;
+            child.wait()?;
+            return Err("bearingd still running 20 s after SIGTERM".into());
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    listener.set_nonblocking(true)?;
+    while let Ok(n) = listener.recv(&mut buffer) {
+        messages.push(String::from_utf8_lossy(&buffer[..n]).into_owned());
+    }
+    assert!(exit.success(), "bearingd exited with {exit} after SIGTERM");
+    assert_eq!(
+        messages.last().map(String::as_str),
+        Some("STOPPING=1"),
+        "{messages:?}"
+    );
+    let logs: Vec<_> = std::fs::read_dir(dir.path().join("mcap"))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+        .collect();
+    assert_eq!(logs.len(), 1, "one log file: {logs:?}");
+    let bytes = std::fs::read(&logs[0])?;
+    assert!(
+        bytes.ends_with(b"\x89MCAP0\r\n"),
+        "{}: not finished (no MCAP magic at the end)",
+        logs[0].display()
+    );
+    Ok(())
+}

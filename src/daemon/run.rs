@@ -270,7 +270,12 @@ pub async fn run(
     let mut sources = tokio::task::JoinSet::new();
     let live = start_live_sources(&config, &input_tx, &stop_rx, &mut sources)?;
     if !sims.is_empty() {
-        sources.spawn(feed_simulated(sims, input_tx.clone(), options.clone()));
+        sources.spawn(feed_simulated(
+            sims,
+            input_tx.clone(),
+            options.clone(),
+            stop_rx.clone(),
+        ));
     }
     // A weak handle on the analysis queue, to see whether inputs wait there; it does not keep
     // the queue open, so the analysis thread still ends when the sources do.
@@ -487,17 +492,26 @@ fn start_live_sources(
     Ok(any)
 }
 
-/// Feeds the simulated sensors' blocks, paced at real time or as fast as the queue takes them.
+/// Feeds the simulated sensors' blocks, paced at real time or as fast as the queue takes them,
+/// until `--duration` or until `stop` turns true (a signal): like the live sources, it must end
+/// for the shutdown to go on (without it SIGTERM never stopped a run with a simulated sensor).
 async fn feed_simulated(
     mut sims: Vec<SimSource>,
     tx: tokio::sync::mpsc::Sender<Input>,
     options: RunOptions,
+    mut stop: tokio::sync::watch::Receiver<bool>,
 ) {
     let mut ticker = tokio::time::interval(std::time::Duration::from_secs_f64(SIM_BLOCK_S));
     ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     loop {
+        if *stop.borrow() {
+            return;
+        }
         if options.realtime {
-            ticker.tick().await;
+            tokio::select! {
+                _ = ticker.tick() => {},
+                _ = stop.changed() => return,
+            }
         }
         for sim in sims.iter_mut() {
             for input in sim.next_blocks() {

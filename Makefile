@@ -1,0 +1,81 @@
+# Installs bearingd as a systemd service. See docs/SYSTEMD.md.
+#
+#   make install                      build (cargo build --release --locked) and install under /usr
+#   make install BIN=path/to/bearingd install an already built binary (e.g. a static musl build)
+#   make install DESTDIR=/srv/root    stage into another root (packaging, VM images)
+#   make uninstall                    remove what install put there (not the config, logs, user)
+#
+# What goes where (PREFIX=/usr by default):
+#   $(PREFIX)/bin/bearingd                         the binary
+#   $(PREFIX)/lib/systemd/system/bearingd.service  the unit (paths rewritten if PREFIX != /usr)
+#   $(PREFIX)/lib/sysusers.d/bearingd.conf         the static system user and group `bearingd`
+#   $(PREFIX)/share/doc/bearingd/SYSTEMD.md        the unit's Documentation=
+#   /etc/bearingd/bearingd.toml                    the default config, never overwritten
+#
+# On a live system (no DESTDIR) install also creates the user (systemd-sysusers) and reloads
+# systemd; with DESTDIR those are left to whoever boots the root (or `systemd-sysusers
+# --root=DIR`), as a package's postinst would do them.
+
+PREFIX ?= /usr
+DESTDIR ?=
+BINDIR ?= $(PREFIX)/bin
+UNITDIR ?= $(PREFIX)/lib/systemd/system
+SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
+DOCDIR ?= $(PREFIX)/share/doc/bearingd
+# The config path is fixed: the unit and the docs name /etc/bearingd/bearingd.toml.
+CONFDIR = /etc/bearingd
+CARGO ?= cargo
+INSTALL ?= install
+# An already built binary to install; empty: build target/release/bearingd with cargo.
+BIN ?=
+
+ifeq ($(BIN),)
+BINARY := target/release/bearingd
+else
+BINARY := $(BIN)
+endif
+
+.PHONY: all build install uninstall
+
+all: build
+
+build:
+ifeq ($(BIN),)
+	$(CARGO) build --release --locked
+else
+	@test -x "$(BIN)" || { echo "make: BIN=$(BIN) is not an executable file" >&2; exit 1; }
+endif
+
+install: build
+	$(INSTALL) -D -m 0755 "$(BINARY)" "$(DESTDIR)$(BINDIR)/bearingd"
+	$(INSTALL) -d -m 0755 "$(DESTDIR)$(UNITDIR)"
+	sed -e 's|/usr/bin/bearingd|$(BINDIR)/bearingd|g' \
+	    -e 's|/usr/share/doc/bearingd/|$(DOCDIR)/|g' \
+	    systemd/bearingd.service > "$(DESTDIR)$(UNITDIR)/bearingd.service"
+	chmod 0644 "$(DESTDIR)$(UNITDIR)/bearingd.service"
+	$(INSTALL) -D -m 0644 systemd/bearingd.sysusers "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf"
+	$(INSTALL) -D -m 0644 docs/SYSTEMD.md "$(DESTDIR)$(DOCDIR)/SYSTEMD.md"
+	$(INSTALL) -d -m 0755 "$(DESTDIR)$(CONFDIR)"
+	@if [ -e "$(DESTDIR)$(CONFDIR)/bearingd.toml" ]; then \
+	  echo "kept the existing $(DESTDIR)$(CONFDIR)/bearingd.toml (the default is in $(DOCDIR) as bearingd.toml.default)"; \
+	  $(INSTALL) -m 0644 config/bearingd.toml "$(DESTDIR)$(DOCDIR)/bearingd.toml.default"; \
+	else \
+	  $(INSTALL) -m 0644 config/bearingd.toml "$(DESTDIR)$(CONFDIR)/bearingd.toml"; \
+	fi
+	@if [ -z "$(DESTDIR)" ]; then \
+	  if command -v systemd-sysusers >/dev/null; then systemd-sysusers bearingd.conf; \
+	  else echo "no systemd-sysusers: create the user with: useradd --system --no-create-home --home-dir /nonexistent --shell /usr/sbin/nologin bearingd"; fi; \
+	  if [ -d /run/systemd/system ]; then systemctl daemon-reload; fi; \
+	  echo "installed; edit $(CONFDIR)/bearingd.toml, then: systemctl enable --now bearingd"; \
+	fi
+
+uninstall:
+	@if [ -z "$(DESTDIR)" ] && [ -d /run/systemd/system ] && systemctl is-enabled --quiet bearingd 2>/dev/null; then \
+	  echo "bearingd is enabled: systemctl disable --now bearingd first" >&2; exit 1; \
+	fi
+	rm -f "$(DESTDIR)$(BINDIR)/bearingd" "$(DESTDIR)$(UNITDIR)/bearingd.service" \
+	      "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf" "$(DESTDIR)$(DOCDIR)/SYSTEMD.md" \
+	      "$(DESTDIR)$(DOCDIR)/bearingd.toml.default"
+	rmdir "$(DESTDIR)$(DOCDIR)" 2>/dev/null || true
+	@if [ -z "$(DESTDIR)" ] && [ -d /run/systemd/system ]; then systemctl daemon-reload; fi
+	@echo "left in place: $(CONFDIR) (your config), /var/lib/bearingd, /var/log/bearingd (data) and the bearingd user"

@@ -1,0 +1,133 @@
+#!/bin/sh
+# The probe of the systemd VM test (tests/vm/systemd_vm_test.sh), run in the VM as the oneshot
+# unit vmtest-probe.service after bearingd.service. Prints "VMTEST <name>: PASS|FAIL <detail>"
+# for: active, alert, stop, mcap-sent; and on any failure `systemctl status` and the journal of
+# bearingd ("DIAG" lines). Sends /var/log/bearingd/*.mcap base64-encoded over /dev/ttyS1.
+# No `set -e`: every check runs and reports, whatever the previous one did.
+set -u
+CONF=/etc/bearingd/bearingd.toml
+SENSOR=${SENSOR:-vm-sim}
+failed=0
+up() { cut -d' ' -f1 /proc/uptime; }
+say() { echo "PROBE [$(up)s] $*"; }
+verdict() { # NAME PASS|FAIL DETAIL
+  echo "VMTEST $1: $2 $3"
+  [ "$2" = PASS ] || failed=1
+}
+prop() { systemctl show -p "$1" --value bearingd; }
+# A monotonic timestamp in µs (systemctl show ...Monotonic) as seconds with one decimal.
+secs() { awk -v us="$1" 'BEGIN { printf "%.1f", us / 1e6 }'; }
+diag() {
+  echo "DIAG ---- systemctl status bearingd"
+  systemctl status bearingd --no-pager -l 2>&1 | cut -c1-400 | sed 's/^/DIAG /'
+  echo "DIAG ---- journalctl -u bearingd (last 80 lines, cut at 400 characters)"
+  journalctl -u bearingd --no-pager -o short-monotonic -n 80 2>&1 | cut -c1-400 | sed 's/^/DIAG /'
+}
+
+say "probe started; $(systemctl is-system-running 2>&1)"
+
+# 1. The service is active: Type=notify, so bearingd itself said READY=1.
+state=$(systemctl is-active bearingd)
+n=0
+while [ "$state" != active ] && [ $n -lt 120 ]; do
+  sleep 1; n=$((n + 1)); state=$(systemctl is-active bearingd)
+done
+if [ "$state" = active ]; then
+  sleep 3 # one status interval (2 s) for the first STATUS=
+  verdict active PASS "started at $(secs "$(prop ExecMainStartTimestampMonotonic)")s, active at $(secs "$(prop ActiveEnterTimestampMonotonic)")s uptime (READY=1), user $(stat -c %U "/proc/$(prop MainPID)" 2>/dev/null || echo "?"), STATUS=\"$(prop StatusText)\""
+else
+  verdict active FAIL "bearingd is $state after waiting ${n}s"
+fi
+active_s=$(secs "$(prop ActiveEnterTimestampMonotonic)")
+
+# 2. An alert over iceoryx2, received by the command-line subscriber. It runs as the service's
+#    user: iceoryx2 0.10 creates its shared memory and sockets owner-only (0600), so the daemon
+#    (user bearingd, no capabilities) cannot open a connection that another user's subscriber
+#    created; a root subscriber gets nothing (checked below, reported as VMINFO).
+# alerts OUT TIMEOUT [PREFIX...]: bearingd alerts --json --count 1, output in OUT and OUT.err.
+alerts() {
+  out=$1 secs=$2
+  shift 2
+  timeout $((secs + 60)) "$@" bearingd alerts --config "$CONF" --json --count 1 \
+    --timeout "$secs" > "$out" 2> "$out.err"
+}
+raised() { # FILE: its first JSON line is the raised outer-race alert of $SENSOR
+  line=$(grep -m1 '^{' "$1")
+  echo "$line" | grep -q '"state": *"raised"' && echo "$line" | grep -q '"fault": *"outer_race"' &&
+    echo "$line" | grep -q "\"sensor\": *\"$SENSOR\""
+}
+t0=$(up)
+alerts /tmp/alerts.out 240 setpriv --reuid=bearingd --regid=bearingd --init-groups
+rc=$?
+t1=$(up)
+sed 's/^/ALERT /' /tmp/alerts.out
+cut -c1-400 /tmp/alerts.out.err | sed 's/^/ALERT stderr: /'
+line=$(grep -m1 '^{' /tmp/alerts.out)
+if [ $rc = 0 ] && raised /tmp/alerts.out; then
+  verdict alert PASS "as user bearingd, exit 0 after $(awk -v a="$t0" -v b="$t1" 'BEGIN{printf "%.1f", b-a}')s (at ${t1}s uptime; bearingd active at ${active_s}s): $line"
+else
+  verdict alert FAIL "as user bearingd, exit $rc after ${t0}s..${t1}s uptime; no JSON line with \"state\":\"raised\" for outer_race of $SENSOR (got: ${line:-nothing}; stderr: $(head -c 400 /tmp/alerts.out.err))"
+fi
+# The same as root, for the record (not a verdict): the brief's intended subscriber.
+alerts /tmp/alerts-root.out 15
+rc=$?
+if [ $rc = 0 ] && raised /tmp/alerts-root.out; then
+  echo "VMINFO alert-as-root: received: $(grep -m1 '^{' /tmp/alerts-root.out)"
+else
+  echo "VMINFO alert-as-root: nothing within 15 s (exit $rc: $(head -c 200 /tmp/alerts-root.out.err | tr '\n' ' '))"
+fi
+
+# 3. The flag in bearingd's STATUS= line (systemd's view of it), before stopping: then the MCAP
+#    file must hold it. Independent of the alerts subscriber.
+n=0
+st=$(prop StatusText)
+while ! echo "$st" | grep -q "outer_race=" && [ $n -lt 60 ]; do
+  sleep 1; n=$((n + 1)); st=$(prop StatusText)
+done
+if echo "$st" | grep -q 'outer_race='; then
+  verdict status-flag PASS "at $(up)s uptime: STATUS=\"$st\""
+else
+  verdict status-flag FAIL "no outer_race flag in STATUS= after ${n}s more: \"$st\""
+fi
+
+# 4. A clean stop: SIGTERM, the MCAP file finished, exit 0.
+pid=$(prop MainPID)
+t0=$(up)
+timeout 60 systemctl stop bearingd
+rc=$?
+t1=$(up)
+state=$(systemctl is-active bearingd)
+result=$(prop Result)
+code=$(prop ExecMainCode)     # 1 = exited (CLD_EXITED), 2 = killed by a signal
+status=$(prop ExecMainStatus)
+detail="systemctl stop exit $rc in $(awk -v a="$t0" -v b="$t1" 'BEGIN{printf "%.1f", b-a}')s (pid $pid), is-active=$state, Result=$result, ExecMainCode=$code, ExecMainStatus=$status"
+if [ $rc = 0 ] && [ "$state" = inactive ] && [ "$result" = success ] && [ "$code" = 1 ] &&
+  [ "$status" = 0 ]; then
+  verdict stop PASS "$detail"
+else
+  verdict stop FAIL "$detail (expected exit 0, inactive, success, code 1 = exited, status 0)"
+fi
+
+# 5. The MCAP file(s) to the host: "MCAP-BEGIN name size sha256", base64, "MCAP-END name".
+files=$(ls /var/log/bearingd/*.mcap 2>/dev/null)
+if [ -z "$files" ]; then
+  verdict mcap-sent FAIL "no *.mcap in /var/log/bearingd: $(ls -la /var/log/bearingd 2>&1 | tr '\n' ' ')"
+elif ! stty -F /dev/ttyS1 raw -echo 2>/tmp/stty.err; then
+  verdict mcap-sent FAIL "cannot set up /dev/ttyS1: $(cat /tmp/stty.err)"
+else
+  t0=$(up)
+  sent=
+  for f in $files; do
+    size=$(stat -c %s "$f")
+    sum=$(sha256sum "$f" | cut -d' ' -f1)
+    { echo "MCAP-BEGIN $(basename "$f") $size $sum"; base64 -w 76 "$f"; echo "MCAP-END $(basename "$f")"; } > /dev/ttyS1
+    sent="$sent $(basename "$f") ($size bytes, owner $(stat -c %U:%G "$f"), mode $(stat -c %a "$f"))"
+  done
+  t1=$(up)
+  verdict mcap-sent PASS "$sent in $(awk -v a="$t0" -v b="$t1" 'BEGIN{printf "%.1f", b-a}')s"
+fi
+
+echo "PROBE journal excerpt of bearingd:"
+journalctl -u bearingd --no-pager -o short-monotonic -n 15 2>&1 | cut -c1-300 | sed 's/^/PROBE   /'
+[ $failed = 0 ] || diag
+say "probe done"
