@@ -382,7 +382,9 @@ mod tests {
         let settings = settings("lost");
         let publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
         let mut subscriber = AlertSubscriber::open(&settings).unwrap();
-        assert!(subscriber.take_history(Duration::from_millis(300)).is_empty());
+        assert!(subscriber
+            .take_history(Duration::from_millis(300))
+            .is_empty());
         let total = SUBSCRIBER_BUFFER as u64 + 44;
         for sequence in 1..=total {
             publisher.send(alert(sequence));

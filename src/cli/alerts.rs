@@ -136,6 +136,7 @@ fn open_when_available(
 ) -> Result<AlertSubscriber, CliError> {
     let mut said = false;
     loop {
+        act_as_daemon_user(settings)?;
         match AlertSubscriber::open(settings) {
             Ok(subscriber) => return Ok(subscriber),
             Err(e) => {
@@ -154,6 +155,58 @@ fn open_when_available(
             }
         }
     }
+}
+
+/// When started as root, becomes the owner of the iceoryx2 root directory (the daemon's user,
+/// `bearingd` under systemd) once it exists.
+///
+/// Why: iceoryx2 0.10 creates its shared memory and sockets readable by their owner only, so
+/// the daemon (not root, no capabilities) cannot connect to a subscriber that root created:
+/// such a subscriber would silently receive nothing. Nothing is done for other users; they
+/// must run as the daemon's user themselves (`sudo -u bearingd bearingd alerts`).
+fn act_as_daemon_user(settings: &AlertServiceSettings) -> Result<(), CliError> {
+    use std::os::unix::fs::MetadataExt;
+    // SAFETY: geteuid has no preconditions.
+    if unsafe { libc::geteuid() } != 0 {
+        return Ok(());
+    }
+    let Some(root) = settings.iox.root_path.as_deref() else {
+        return Ok(());
+    };
+    let Ok(meta) = std::fs::metadata(root) else {
+        return Ok(()); // not created yet: the daemon has not started
+    };
+    if meta.uid() == 0 {
+        return Ok(());
+    }
+    let fail = |what: &str| {
+        CliError::failure(format!(
+            "cannot switch to the owner (uid {}, gid {}) of the iceoryx2 root {root} ({what}: {}); \
+             run as that user instead, e.g. sudo -u bearingd bearingd alerts ...",
+            meta.uid(),
+            meta.gid(),
+            std::io::Error::last_os_error()
+        ))
+    };
+    // SAFETY: plain system calls on integers; the order (groups, gid, then uid) is the one
+    // that leaves no root privilege behind.
+    unsafe {
+        if libc::setgroups(0, std::ptr::null()) != 0 {
+            return Err(fail("setgroups"));
+        }
+        if libc::setgid(meta.gid()) != 0 {
+            return Err(fail("setgid"));
+        }
+        if libc::setuid(meta.uid()) != 0 {
+            return Err(fail("setuid"));
+        }
+    }
+    eprintln!(
+        "bearingd alerts: running as uid {} (the owner of {root}, the daemon's user), so the \
+         daemon can deliver to this subscriber",
+        meta.uid()
+    );
+    Ok(())
 }
 
 struct Printer {

@@ -8,7 +8,9 @@
 # initramfs with systemd as PID 1 (rdinit=/lib/systemd/systemd) under qemu TCG. A oneshot probe
 # unit (tests/vm/systemd_probe.sh) then checks, each ending in "VMTEST <name>: PASS|FAIL ...":
 #   active     bearingd reached "active" (Type=notify: READY=1 sent) and reports STATUS=
-#   alert      `bearingd alerts --json --count 1` received the outer-race alert, state "raised"
+#   alert      `bearingd alerts --json --count 1`, started as root, received the outer-race
+#              alert, state "raised"
+#   alert-history  a late `bearingd alerts` as user bearingd got the active alert from history
 #   status-flag  the flag shows in the STATUS= line bearingd sends systemd
 #   stop       `systemctl stop bearingd`: inactive, Result=success, main process exited 0
 #   mcap-sent  the MCAP file(s) of /var/log/bearingd were sent to the host over a second serial
@@ -246,7 +248,7 @@ echo "VMTEST mcap: $mcap_ok $mcap_detail" | tee -a "$WORK/host-verdicts.log"
 # 9. Verdict: every expected line present, none failed.
 status=0
 cat "$WORK/host-verdicts.log" >> "$WORK/serial.txt"
-for check in install active alert status-flag stop mcap-sent mcap; do
+for check in install active alert alert-history status-flag stop mcap-sent mcap; do
   line=$(grep -a -m1 "^VMTEST $check: " "$WORK/serial.txt" || true)
   case "$line" in
     "VMTEST $check: PASS"*) ;;

@@ -1,0 +1,154 @@
+//! Alert latency (issue 6 target, reported in docs/ALERTS.md and docs/PERFORMANCE.md): from the
+//! end of the window that raises an alert to a subscriber's receipt, p50 and p99.
+//!
+//! What is measured: the daemon (`bearingd run`, a separate process, real time) runs
+//! `BENCH_SENSORS` simulated sensors at `BENCH_RATE` Hz whose outer races fail one after the
+//! other; this process subscribes to the alert service and, for each alert, takes its receipt
+//! time minus the alert's `wall_time_ns`: the moment the daemon's analysis took the block that
+//! completed the deciding window. Both clocks are the same machine's `CLOCK_REALTIME`.
+//! So the latency covers the analysis of that block (and of any block queued before it), the
+//! flag decision, the alert queue, iceoryx2 and the subscriber's wake-up; it does not cover
+//! the sensor's own block length (0.1 s of samples) or transport before the daemon.
+//!
+//! Run: `cargo bench --bench alert_latency` (about `BENCH_ROUNDS` × 75 s).
+
+use bearingd::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
+use bearingd::ingest::shm::IoxSettings;
+use bearingd::mcap_log::wall_clock_now_ns;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+fn env_or(name: &str, default: usize) -> usize {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// `sensors` simulated sensors; sensor j's outer race fails at 2 + 2.5 j s.
+fn write_config(dir: &Path, iox: &Path, sensors: usize, rate: usize) -> PathBuf {
+    let mut text = String::new();
+    for j in 0..sensors {
+        let _ = write!(
+            text,
+            r#"
+[[sensors]]
+id = "s{j:02}"
+transport = "sim"
+sample_rate_hz = {rate}
+bearing = "skf-6205-2rs"
+[sensors.speed]
+source = "fixed"
+rpm = 1772
+[sensors.sim]
+fault = "outer"
+onset_s = {onset}
+severity = 1.5
+seed = {seed}
+"#,
+            onset = 2.0 + 2.5 * j as f64,
+            seed = j + 1
+        );
+    }
+    let _ = write!(
+        text,
+        r#"
+[outputs]
+state_dir = "{state}"
+mcap_dir = "{mcap}"
+iceoryx2_root = "{iox}"
+"#,
+        state = dir.join("state").display(),
+        mcap = dir.join("mcap").display(),
+        iox = iox.display()
+    );
+    let path = dir.join("bench.toml");
+    std::fs::write(&path, text).expect("write the bench config");
+    path
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    let rank = ((p / 100.0) * sorted.len() as f64).ceil() as usize;
+    sorted[rank.clamp(1, sorted.len()) - 1]
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--list") {
+        return; // `cargo test --benches` asks for a list; nothing to run quickly here
+    }
+    let sensors = env_or("BENCH_SENSORS", 16);
+    let rate = env_or("BENCH_RATE", 25_600);
+    let rounds = env_or("BENCH_ROUNDS", 2);
+    let duration_s = 20.0 + 2.5 * sensors as f64 + 20.0;
+    let mut latencies_ms = Vec::new();
+    let mut lost = 0u64;
+    for round in 0..rounds {
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("alert-latency-{round}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("bench dir");
+        let iox = dir.join("iox");
+        let config = write_config(&dir, &iox, sensors, rate);
+        let prefix = format!("bdbench{}_", std::process::id());
+        let mut daemon = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+            .args([
+                "run",
+                "--quiet",
+                "--duration",
+                &duration_s.to_string(),
+                "--config",
+            ])
+            .arg(&config)
+            .env("BEARINGD_IOX_PREFIX", &prefix)
+            .stdout(Stdio::null())
+            .spawn()
+            .expect("start bearingd");
+        let settings = AlertServiceSettings {
+            service: "bearingd/alerts".into(),
+            iox: IoxSettings {
+                prefix: Some(prefix),
+                root_path: Some(iox.display().to_string()),
+            },
+        };
+        let started = Instant::now();
+        let mut subscriber = loop {
+            match AlertSubscriber::open(&settings) {
+                Ok(s) => break s,
+                Err(e) if started.elapsed() > Duration::from_secs(30) => {
+                    panic!("the daemon's alert service never appeared: {e}")
+                }
+                Err(_) => std::thread::sleep(Duration::from_millis(50)),
+            }
+        };
+        subscriber.take_history(Duration::from_millis(200));
+        let mut round_alerts = 0;
+        while started.elapsed().as_secs_f64() < duration_s + 5.0 {
+            match subscriber.next(Duration::from_millis(500)) {
+                Some(Received::Alert(alert)) => {
+                    let latency_ns = wall_clock_now_ns() as f64 - alert.wall_time_ns as f64;
+                    latencies_ms.push(latency_ns / 1e6);
+                    round_alerts += 1;
+                }
+                Some(Received::Lost { first, last, .. }) => lost += last - first + 1,
+                Some(Received::NewRun { .. }) | None => {}
+            }
+            if let Ok(Some(_)) = daemon.try_wait() {
+                break;
+            }
+        }
+        let _ = daemon.wait();
+        eprintln!("round {round}: {round_alerts} alerts");
+    }
+    assert!(!latencies_ms.is_empty(), "no alert arrived");
+    latencies_ms.sort_by(f64::total_cmp);
+    println!(
+        "alert latency, {sensors} sensors at {rate} Hz, {rounds} round(s): {} alerts ({lost} lost), \
+         p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms, min {:.2} ms",
+        latencies_ms.len(),
+        percentile(&latencies_ms, 50.0),
+        percentile(&latencies_ms, 99.0),
+        latencies_ms.last().unwrap(),
+        latencies_ms[0]
+    );
+}
