@@ -7,4 +7,5 @@ mod developer_set;
 mod envelope;
 mod kinematics;
 mod monitor;
+mod speed;
 mod twin;
