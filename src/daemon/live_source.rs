@@ -28,7 +28,7 @@ impl NodeMap {
     }
 
     /// The pipeline's input for a source's event; `None` for events the pipeline does not
-    /// need (metadata, speed, malformed frames: counted by the source).
+    /// need (metadata, malformed frames: counted by the source).
     pub fn to_input(&self, event: IngestEvent) -> Option<Input> {
         let channel = |node: u8, axis: u8| {
             self.nodes.get(&node).and_then(|(sensor, axes)| {
@@ -58,6 +58,10 @@ impl NodeMap {
             }),
             IngestEvent::SensorBack { node } => Some(Input::SensorBack {
                 sensor: self.nodes.get(&node)?.0.clone(),
+            }),
+            IngestEvent::Speed { node, rpm, .. } => Some(Input::Speed {
+                sensor: self.nodes.get(&node)?.0.clone(),
+                rpm: rpm.map(f64::from),
             }),
             // A gap shows in the next block's first sample; the monitor reports it there.
             _ => None,

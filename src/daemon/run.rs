@@ -476,11 +476,17 @@ pub fn status_line(s: &ChannelStatus) -> String {
         .filter(|(_, l)| l.name() != "ok")
         .map(|(k, l)| format!("{}={}", k.name(), l.name()))
         .collect();
+    let rpm = match (s.rpm, s.speed_source) {
+        (Some(rpm), "fixed") => format!("{rpm:.0}"),
+        (Some(rpm), source) => format!("{rpm:.0}({source})"),
+        (None, "estimate") => "?(no estimate yet: scoring waits)".to_string(),
+        (None, _) => "?(no usable speed frame: scoring waits)".to_string(),
+    };
     format!(
-        "{} t={:.1}s rpm={:.0} band={} top={} twin={} stage={} flags={}{}",
+        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} flags={}{}",
         s.channel,
         s.seconds,
-        s.rpm,
+        rpm,
         band,
         top,
         twin,
