@@ -7,8 +7,8 @@
 //! samples gives the same flags at the same samples.
 
 use super::messages::{
-    ChannelId, FlagMessage, HealthMessage, IndicatorsMessage, PipelineMessage, RawBlock,
-    SpectrumMessage, SpeedMessage,
+    ChannelId, FlagMessage, HealthMessage, IndicatorsMessage, IngestMessage, PipelineMessage,
+    RawBlock, SpectrumMessage, SpeedMessage,
 };
 use crate::analysis::flags::{FlagLevel, FlagSettings};
 use crate::analysis::health::{Baseline, HealthStage};
@@ -51,6 +51,8 @@ pub enum Input {
     },
     /// A logged measured speed (a replay): takes effect at its own sample.
     LoggedSpeed(SpeedMessage),
+    /// A live source's counters, passed on to the sinks (the log) in order with the data.
+    Ingest(IngestMessage),
 }
 
 /// A request for the twin's re-fit, handed to the re-fit thread.
@@ -363,6 +365,7 @@ impl Pipeline {
                     }
                 }
             }
+            Input::Ingest(message) => out(Output::Message(PipelineMessage::Ingest(message))),
             Input::SensorLost { sensor } => self.sensor_event(&sensor, true, out),
             Input::SensorBack { sensor } => self.sensor_event(&sensor, false, out),
             Input::Restart {
