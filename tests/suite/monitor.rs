@@ -272,3 +272,50 @@ fn a_given_speed_takes_effect_at_its_sample_and_without_one_nothing_is_scored() 
         );
     }
 }
+
+/// An estimating channel (nominal speed 3 % off) estimates the speed at its first band
+/// selection, before any score, and then raises the outer-race flag as with the true speed.
+#[test]
+fn an_estimating_channel_finds_the_speed_before_it_scores() {
+    let (counts, params) = counts(40.0, 0.0);
+    let fs = params.fs_hz;
+    let shaft = params.rpm / 60.0;
+    let mut s = settings(fs);
+    s.speed = SpeedMode::Estimate(bearingd::analysis::speed::SpeedSearch {
+        nominal_hz: shaft * 1.03,
+        range: 0.05,
+    });
+    let monitor = ChannelMonitor::new(s, params.bearing.fault_frequencies(shaft * 1.03), None);
+    let events = run_monitor(monitor, &counts, 4_096, &[]);
+    let first_speed = events
+        .iter()
+        .position(|e| e.starts_with("speed"))
+        .expect("an estimate");
+    let estimated: f64 = events[first_speed]
+        .trim_start_matches("speed Some(")
+        .split(')')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        (estimated / shaft - 1.0).abs() < 0.005,
+        "{estimated} Hz for {shaft} Hz"
+    );
+    assert!(events[first_speed + 1].starts_with("bands"), "{events:#?}");
+    assert!(
+        events[..first_speed].iter().all(|e| !e.starts_with("flag")),
+        "{events:#?}"
+    );
+    assert!(
+        events.iter().any(|e| e.starts_with("flag outer_race Ok->")),
+        "{events:#?}"
+    );
+    assert!(
+        events
+            .iter()
+            .filter(|e| e.starts_with("flag"))
+            .all(|e| e.starts_with("flag outer_race")),
+        "{events:#?}"
+    );
+}
