@@ -437,17 +437,100 @@ fn transport_tables_must_match_the_transport() {
     );
 }
 
+/// A CAN sensor, to which tests add a `[sensors.speed]` table.
+const CAN_SENSOR: &str = r#"
+[[sensors]]
+id = "motor-de"
+transport = "can"
+sample_rate_hz = 25600
+bearing = "skf-6205-2rs"
+[sensors.can]
+interface = "vcan0"
+node_id = 1
+"#;
+
+fn speed_of(text: &str) -> Speed {
+    config::parse(text, "test.toml")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .sensors[0]
+        .speed
+}
+
 #[test]
-fn reserved_speed_sources_are_not_yet_supported() {
-    let text = SENSOR.replace("rpm = 1772", "source = \"estimate\"");
-    let found = problems(&text);
-    assert_eq!(keys(&found), ["sensors[0].speed.source"]);
-    assert!(
-        found[0].message.contains("not yet supported"),
-        "{}",
-        found[0]
+fn speed_from_frames_and_estimated_speed_are_configured_with_their_defaults() {
+    let can = |table: &str| format!("{CAN_SENSOR}[sensors.speed]\n{table}");
+    assert_eq!(
+        speed_of(&can("source = \"can\"\nrpm = 1772\n")),
+        Speed::Frames {
+            nominal_rpm: Some(1772.0),
+            max_rpm: 1772.0 * 1.5
+        }
     );
-    assert_has_fix(&found[0]);
+    assert_eq!(
+        speed_of(&can("source = \"can\"\nmax_rpm = 3600\n")),
+        Speed::Frames {
+            nominal_rpm: None,
+            max_rpm: 3600.0
+        }
+    );
+    assert_eq!(
+        speed_of(&can("source = \"estimate\"\nrpm = 1772\n")),
+        Speed::Estimate {
+            rpm: 1772.0,
+            search: 0.05
+        }
+    );
+    assert_eq!(
+        speed_of(&SENSOR.replace(
+            "rpm = 1772",
+            "source = \"estimate\"\nrpm = 1772\nsearch = 0.1"
+        )),
+        Speed::Estimate {
+            rpm: 1772.0,
+            search: 0.1
+        }
+    );
+}
+
+#[test]
+fn speed_mistakes_are_listed_at_once_with_their_fix() {
+    // A simulated sensor sends no speed frames; a key of another source would be ignored;
+    // without a nominal rpm max_rpm has no default; an estimate needs its nominal rpm; a
+    // search range out of bounds; max_rpm not above the nominal speed.
+    let text = format!(
+        "{}{}{}{}",
+        SENSOR.replace("rpm = 1772", "source = \"can\"\nrpm = 1772\nsearch = 0.05"),
+        CAN_SENSOR
+            .replace("motor-de", "b")
+            .replace("node_id = 1", "node_id = 2")
+            + "[sensors.speed]\nsource = \"can\"\n",
+        CAN_SENSOR
+            .replace("motor-de", "c")
+            .replace("node_id = 1", "node_id = 3")
+            + "[sensors.speed]\nsource = \"estimate\"\nsearch = 0.5\nmax_rpm = 2000\n",
+        CAN_SENSOR
+            .replace("motor-de", "d")
+            .replace("node_id = 1", "node_id = 4")
+            + "[sensors.speed]\nsource = \"can\"\nrpm = 1800\nmax_rpm = 1700\n",
+    );
+    let found = problems(&text);
+    assert_eq!(
+        keys(&found),
+        [
+            "sensors[0].speed.search",
+            "sensors[0].speed.source",
+            "sensors[1].speed.max_rpm",
+            "sensors[2].speed.max_rpm",
+            "sensors[2].speed.rpm",
+            "sensors[3].speed.max_rpm",
+        ],
+        "{found:#?}"
+    );
+    assert!(found[1].message.contains("no speed frames"), "{}", found[1]);
+    found.iter().for_each(assert_has_fix);
+    let unknown = problems(&SENSOR.replace("rpm = 1772", "source = \"tacho\""));
+    assert_eq!(keys(&unknown), ["sensors[0].speed.source"]);
+    assert_has_fix(&unknown[0]);
 }
 
 #[test]

@@ -121,6 +121,23 @@ fn every_type() -> Vec<PipelineMessage> {
             malformed: 0,
             restarts: 0,
             dropped_blocks: 0,
+            speed_frames: 10,
+            sensor_lost: 1,
+            handoff_dropped: 2,
+        }),
+        PipelineMessage::Speed(SpeedMessage {
+            channel: ch("motor-de", "radial"),
+            end_sample: 25_600,
+            source: "can".into(),
+            given_rpm: Some(1772.25),
+            rpm: Some(1772.25),
+        }),
+        PipelineMessage::Speed(SpeedMessage {
+            channel: ch("motor-de", "radial"),
+            end_sample: 51_200,
+            source: "can".into(),
+            given_rpm: None,
+            rpm: None,
         }),
     ]
 }
@@ -135,6 +152,7 @@ fn topic_and_json(m: &PipelineMessage) -> (String, String) {
         PipelineMessage::Flag(s) => (format!("/flags/{}", s.channel), j(s)),
         PipelineMessage::Health(s) => (format!("/health/{}", s.channel), j(s)),
         PipelineMessage::Ingest(s) => (format!("/ingest/{}", s.source), j(s)),
+        PipelineMessage::Speed(s) => (format!("/speed/{}", s.channel), j(s)),
     }
 }
 

@@ -54,6 +54,16 @@ impl FftPlans {
             .clone()
     }
 
+    /// The cached Hann window of `len` samples.
+    pub(crate) fn hann_window(&mut self, len: usize) -> Arc<[f32]> {
+        self.hann(len)
+    }
+
+    /// The cached forward real FFT of `len` samples.
+    pub(crate) fn real_forward_plan(&mut self, len: usize) -> Arc<dyn RealToComplex<f32>> {
+        self.real_forward(len)
+    }
+
     fn inverse(&mut self, len: usize) -> Arc<dyn Fft<f32>> {
         self.complex.plan_fft_inverse(len)
     }

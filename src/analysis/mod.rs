@@ -11,6 +11,7 @@
 //! - [`diagnosis`]: the verdict and its confidence.
 //! - [`indicators`]: RMS, peak, crest factor, kurtosis.
 //! - [`record`]: all of the above over one whole record (`bearingd analyze`).
+//! - [`speed`]: the shaft speed estimated from the spectrum near a nominal speed.
 
 pub mod band;
 pub mod diagnosis;
@@ -23,6 +24,7 @@ pub mod kurtogram;
 pub mod monitor;
 pub mod record;
 pub mod settings;
+pub mod speed;
 
 pub use band::Band;
 pub use diagnosis::{Diagnosis, Verdict};

@@ -17,6 +17,14 @@
 //! - Health: the stage tracker, fed with each window's kurtosis and RMS.
 //! - Sensor: clipping (counts at full scale) and a flat line (no change for a second) are
 //!   reported when they start and when they end.
+//! - Speed ([`SpeedMode`]): fixed, given from outside at a sample position (speed frames, or a
+//!   replay of the logged speed), or estimated from the history at every band selection
+//!   ([`super::speed`]). (choice) While the speed is unknown (no speed frame yet and no nominal
+//!   speed, a frame saying "not available", 0 or above the configured maximum, no estimate
+//!   yet) the channel scores nothing, its flags hold their level (neither rise nor fall on a
+//!   wrong speed) and no band selection runs; indicators and health go on. A speed change takes
+//!   effect at a sample, so a replay that feeds the logged changes at their samples repeats
+//!   every event.
 //!
 //! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
 
@@ -27,6 +35,7 @@ use super::flags::{FaultFlag, FlagChange, FlagSettings};
 use super::health::{Baseline, HealthTracker, StageChange};
 use super::indicators::Indicators;
 use super::record::{analyze_with_plans, envelope_range_hz};
+use super::speed::{estimate_shaft_hz, SpeedSearch};
 use super::{AnalysisSettings, Band};
 use crate::bearing::FaultFrequencies;
 
@@ -44,6 +53,35 @@ pub struct MonitorSettings {
     pub clip_count: i32,
     /// Samples without any change that make a flat line.
     pub flat_line_samples: u64,
+    /// Where the shaft speed comes from.
+    pub speed: SpeedMode,
+}
+
+/// Where a channel's shaft speed comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SpeedMode {
+    /// The speed given to [`ChannelMonitor::new`], for good.
+    Fixed,
+    /// Given from outside with [`ChannelMonitor::set_speed_at`]: `known_at_start` says whether
+    /// the speed given to `new` may be used until then (a nominal speed) or the channel waits.
+    /// Speeds above `max_shaft_hz` (the envelope spectrum is sized for it) are not usable.
+    Given {
+        known_at_start: bool,
+        max_shaft_hz: f64,
+    },
+    /// Estimated from the history at every band selection, within the search.
+    Estimate(SpeedSearch),
+}
+
+impl SpeedMode {
+    /// The highest shaft rate the channel analyses, given the starting one.
+    fn max_shaft_hz(&self, start_hz: f64) -> f64 {
+        match *self {
+            SpeedMode::Fixed => start_hz,
+            SpeedMode::Given { max_shaft_hz, .. } => max_shaft_hz.max(start_hz),
+            SpeedMode::Estimate(search) => search.nominal_hz * (1.0 + search.range),
+        }
+    }
 }
 
 /// A sensor-health finding.
@@ -101,12 +139,28 @@ pub enum MonitorEvent<'a> {
         at_sample: u64,
         missing: u64,
     },
+    /// The shaft speed the channel uses changed (or was set again), from `at_sample` on;
+    /// `shaft_hz` is `None` when it is unknown or unusable from there (see [`SpeedMode`]).
+    Speed {
+        at_sample: u64,
+        shaft_hz: Option<f64>,
+        /// Given to `set_speed_at` (`None` if it was "not available"); differs from
+        /// `shaft_hz` when the given speed is not usable.
+        given_hz: Option<f64>,
+        estimated: bool,
+    },
 }
 
 /// The streaming analysis of one channel.
 pub struct ChannelMonitor {
     settings: MonitorSettings,
     freqs: FaultFrequencies,
+    /// Fault frequencies per Hz of shaft rate: `freqs` at any speed.
+    orders: FaultFrequencies,
+    /// Whether `freqs` may be scored (see [`SpeedMode`]).
+    speed_known: bool,
+    /// A speed change given for a sample not reached yet: (sample, shaft rate).
+    pending_speed: Option<(u64, Option<f64>)>,
     rolling: RollingEnvelope,
     scorer: FaultScorer,
     flags: [FaultFlag; 4],
@@ -153,9 +207,17 @@ impl ChannelMonitor {
         let window = window_samples(settings.analysis.window_s, settings.fs_hz);
         let hop = super::envelope::hop_samples(window, settings.analysis.overlap);
         let bin_hz = settings.fs_hz / window as f64;
-        let bins =
-            ((envelope_range_hz(&freqs, settings.analysis.harmonics) / bin_hz).ceil() as usize + 1)
-                .min(window / 2);
+        let orders = scaled(&freqs, 1.0 / freqs.shaft);
+        let fastest = scaled(&orders, settings.speed.max_shaft_hz(freqs.shaft));
+        let bins = ((envelope_range_hz(&fastest, settings.analysis.harmonics) / bin_hz).ceil()
+            as usize
+            + 1)
+        .min(window / 2);
+        let speed_known = match settings.speed {
+            SpeedMode::Fixed => true,
+            SpeedMode::Given { known_at_start, .. } => known_at_start,
+            SpeedMode::Estimate(_) => false,
+        };
         let whole = Band::new(0.0, settings.fs_hz / 2.0);
         // No band engines until the first selection: they would be full-band (large) and
         // unused, since no flag rises before the bands are known.
@@ -193,6 +255,9 @@ impl ChannelMonitor {
             flat_since: 0,
             last_count: None,
             freqs,
+            orders,
+            speed_known,
+            pending_speed: None,
             settings,
         }
     }
@@ -201,9 +266,64 @@ impl ChannelMonitor {
         &self.freqs
     }
 
-    /// A new shaft speed (from a speed frame or an estimate): fault frequencies follow.
-    pub fn set_frequencies(&mut self, freqs: FaultFrequencies) {
-        self.freqs = freqs;
+    /// The shaft rate the channel scores with, Hz; `None` while it is unknown.
+    pub fn shaft_hz(&self) -> Option<f64> {
+        self.speed_known.then_some(self.freqs.shaft)
+    }
+
+    /// A shaft rate given from outside (`None`: not available), to take effect at
+    /// `at_sample`: now if the channel is there (or past it: a late change applies at once),
+    /// else when its samples reach it. Only one change waits; a second one arriving first
+    /// makes the waiting one take effect at once (its samples never came). Ignored in the
+    /// fixed and estimating modes.
+    pub fn set_speed_at(
+        &mut self,
+        at_sample: u64,
+        shaft_hz: Option<f64>,
+        on_event: &mut impl FnMut(MonitorEvent),
+    ) {
+        if !matches!(self.settings.speed, SpeedMode::Given { .. }) {
+            return;
+        }
+        if at_sample > self.next_sample {
+            if let Some((_, waiting)) = self.pending_speed.take() {
+                self.apply_speed(waiting, false, on_event);
+            }
+            self.pending_speed = Some((at_sample, shaft_hz));
+        } else {
+            self.apply_speed(shaft_hz, false, on_event);
+        }
+    }
+
+    /// Uses `given` from the current sample on, if usable; selects the bands at once when the
+    /// speed becomes known with a full history and no bands yet.
+    fn apply_speed(
+        &mut self,
+        given: Option<f64>,
+        estimated: bool,
+        on_event: &mut impl FnMut(MonitorEvent),
+    ) {
+        let max = self.settings.speed.max_shaft_hz(self.freqs.shaft);
+        let usable = given.filter(|&hz| hz.is_finite() && hz > 0.0 && hz <= max * (1.0 + 1e-9));
+        let was_known = self.speed_known;
+        if let Some(hz) = usable {
+            self.freqs = scaled(&self.orders, hz);
+        }
+        self.speed_known = usable.is_some();
+        on_event(MonitorEvent::Speed {
+            at_sample: self.next_sample,
+            shaft_hz: usable,
+            given_hz: given,
+            estimated,
+        });
+        if !was_known
+            && self.speed_known
+            && !estimated
+            && !self.bands_known
+            && self.history_filled == self.history.len()
+        {
+            self.select_bands(on_event);
+        }
     }
 
     pub fn bands(&self) -> Option<&[Band; 4]> {
@@ -273,12 +393,21 @@ impl ChannelMonitor {
     /// sample whatever the block sizes.
     fn push_samples(&mut self, mut samples: &[f32], on_event: &mut impl FnMut(MonitorEvent)) {
         while !samples.is_empty() {
+            if let Some((at, hz)) = self.pending_speed {
+                if at <= self.next_sample {
+                    self.pending_speed = None;
+                    self.apply_speed(hz, false, on_event);
+                }
+            }
             let until_selection = self.next_band_selection.saturating_sub(self.next_sample);
-            let take = if until_selection == 0 {
+            let mut take = if until_selection == 0 {
                 samples.len()
             } else {
                 samples.len().min(until_selection as usize)
             };
+            if let Some((at, _)) = self.pending_speed {
+                take = take.min((at - self.next_sample) as usize);
+            }
             self.analyse(&samples[..take], on_event);
             samples = &samples[take..];
             if self.next_sample >= self.next_band_selection {
@@ -313,16 +442,20 @@ impl ChannelMonitor {
             bands,
             bands_known,
             freqs,
+            speed_known,
             ..
         } = self;
+        let speed_known = *speed_known;
         rolling.push(samples, |update| {
             let indicators =
                 Indicators::of_slices(&[update.window_samples.0, update.window_samples.1]);
-            // Before the first band selection there are no band engines: nothing to score.
+            // Before the first band selection there are no band engines: nothing to score; nor
+            // without a speed to score against.
             for (i, kind) in FaultKind::ALL.iter().enumerate() {
                 let spectrum = update
                     .bands
                     .get(i)
+                    .filter(|_| speed_known)
                     .map_or(&[][..], |b| b.averaged_amplitude());
                 scores[i] = scorer.score(spectrum, update.bin_hz, *kind, freqs);
             }
@@ -331,7 +464,7 @@ impl ChannelMonitor {
             {
                 on_event(MonitorEvent::Stage(change));
             }
-            if *bands_known {
+            if *bands_known && speed_known {
                 // Only the dominating fault feeds its flag (the verdict's rule: its score at least
                 // `min_score_ratio` times every other); the others see 0 and fall.
                 let dominant = dominant_fault(scores, min_score_ratio);
@@ -377,9 +510,29 @@ impl ChannelMonitor {
     /// Runs the whole-record analysis over the history and follows its bands.
     fn select_bands(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
         let n = self.history.len();
+        let estimating = matches!(self.settings.speed, SpeedMode::Estimate(_));
+        if !self.speed_known && !estimating {
+            return;
+        }
         let contiguous: Vec<f32> = (0..n)
             .map(|i| self.history_sample((self.history_at + i) % n))
             .collect();
+        if let SpeedMode::Estimate(search) = self.settings.speed {
+            // A failed estimate keeps the last one; without any, nothing is scored yet. (The
+            // plans' lock is not held while events go out.)
+            let estimate = estimate_shaft_hz(
+                &mut FftPlans::shared(),
+                &contiguous,
+                self.settings.fs_hz,
+                search,
+            );
+            if let Some(estimate) = estimate {
+                self.apply_speed(Some(estimate.shaft_hz), true, on_event);
+            }
+            if !self.speed_known {
+                return;
+            }
+        }
         let analysis = analyze_with_plans(
             &mut FftPlans::shared(),
             &contiguous,
@@ -459,5 +612,18 @@ impl ChannelMonitor {
                 });
             }
         }
+    }
+}
+
+/// `freqs` with every frequency multiplied by `factor` (they are all proportional to the shaft
+/// rate, MODELS.md §1).
+fn scaled(freqs: &FaultFrequencies, factor: f64) -> FaultFrequencies {
+    FaultFrequencies {
+        shaft: freqs.shaft * factor,
+        ftf: freqs.ftf * factor,
+        bpfo: freqs.bpfo * factor,
+        bpfi: freqs.bpfi * factor,
+        bsf: freqs.bsf * factor,
+        two_bsf: freqs.two_bsf * factor,
     }
 }

@@ -224,6 +224,7 @@ fn start_source(
                 receive_buffer_bytes: args.rcvbuf,
                 capture,
                 capture_frames: args.capture_frames,
+                stats_interval: None,
             })
             .map_err(CliError::input)?;
             let task = tokio::spawn(async move {
@@ -259,6 +260,7 @@ fn start_source(
             } else {
                 WhenFull::DropOldest
             },
+            stats_interval: None,
         };
         let task = tokio::spawn(async move {
             shm::run(config, events, shutdown)

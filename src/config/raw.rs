@@ -81,9 +81,13 @@ pub(crate) struct RawSensor {
 #[derive(Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawSpeed {
-    /// `"fixed"`; `"can"` and `"estimate"` are reserved (read, then refused by validation).
+    /// `"fixed"`, `"can"` or `"estimate"`.
     pub source: Field<String>,
     pub rpm: Field<f64>,
+    /// `"can"` only.
+    pub max_rpm: Field<f64>,
+    /// `"estimate"` only.
+    pub search: Field<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]

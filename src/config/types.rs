@@ -125,16 +125,61 @@ pub enum SimFault {
 pub enum Speed {
     /// A constant speed, in revolutions per minute; in (0, 100 000).
     Fixed { rpm: f64 },
+    /// Measured: the sensor's speed frames (`source = "can"`; the iceoryx2 transport carries
+    /// the same frames). Until the first frame the channel uses `nominal_rpm` if given, else it
+    /// scores no fault and says so.
+    #[serde(rename = "can")]
+    Frames {
+        /// The speed to assume until the first speed frame; in (0, 100 000).
+        nominal_rpm: Option<f64>,
+        /// The highest speed the channel analyses (its envelope spectrum is sized for the fault
+        /// harmonics at this speed); above `nominal_rpm`, below 100 000. A frame above it (or
+        /// "not available", or 0) leaves the channel without a usable speed until the next.
+        max_rpm: f64,
+    },
+    /// Estimated from the vibration within `rpm·(1 ± search)`, at every band selection.
+    Estimate {
+        /// The nominal speed, in revolutions per minute; in (0, 100 000).
+        rpm: f64,
+        /// Relative half-width of the search; in (0, 0.3].
+        search: f64,
+    },
 }
 
 impl Speed {
-    /// The shaft rotation frequency, in Hz.
-    pub fn shaft_hz(&self) -> f64 {
+    /// The speed the channel assumes at its start, rpm; `None` while it must wait for a speed
+    /// frame. (An estimating channel starts at its nominal speed, but scores nothing before its
+    /// first band selection, which estimates first.)
+    pub fn initial_rpm(&self) -> Option<f64> {
+        match *self {
+            Speed::Fixed { rpm } | Speed::Estimate { rpm, .. } => Some(rpm),
+            Speed::Frames { nominal_rpm, .. } => nominal_rpm,
+        }
+    }
+
+    /// The highest speed the channel analyses, rpm.
+    pub fn max_rpm(&self) -> f64 {
+        match *self {
+            Speed::Fixed { rpm } => rpm,
+            Speed::Frames { max_rpm, .. } => max_rpm,
+            Speed::Estimate { rpm, search } => rpm * (1.0 + search),
+        }
+    }
+
+    /// The name of the source, as in the config.
+    pub fn source_name(&self) -> &'static str {
         match self {
-            Speed::Fixed { rpm } => rpm / 60.0,
+            Speed::Fixed { .. } => "fixed",
+            Speed::Frames { .. } => "can",
+            Speed::Estimate { .. } => "estimate",
         }
     }
 }
+
+/// Default `max_rpm` of `source = "can"` with a nominal speed: this factor times it.
+pub(crate) const DEFAULT_MAX_RPM_FACTOR: f64 = 1.5;
+/// Default `search` of `source = "estimate"`: ±5 %.
+pub(crate) const DEFAULT_SPEED_SEARCH: f64 = 0.05;
 
 /// `[twin]`: the signal-model twin's re-fit schedule.
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -18,7 +18,7 @@ use super::raw::{
 use super::types::{
     CanConfig, Config, OutputConfig, SensorConfig, ShmConfig, SimConfig, SimFault, Speed,
     ThresholdConfig, Transport, TwinConfig, DEFAULT_AXIS, DEFAULT_BAND_PERIOD_S,
-    DEFAULT_CAN_INTERFACE, DEFAULT_SCALE_G_PER_COUNT,
+    DEFAULT_CAN_INTERFACE, DEFAULT_MAX_RPM_FACTOR, DEFAULT_SCALE_G_PER_COUNT, DEFAULT_SPEED_SEARCH,
 };
 
 /// Longest sensor id, in characters.
@@ -397,7 +397,7 @@ impl Checker {
 
         let bearing = self.bearing(&at("bearing"), &raw.bearing);
 
-        let speed = self.speed(&at("speed"), raw.speed.as_ref());
+        let speed = self.speed(&at("speed"), raw.speed.as_ref(), kind);
 
         let transport = match kind {
             Some(kind) => self.transport(i, kind, id.as_deref(), raw),
@@ -563,7 +563,7 @@ impl Checker {
         }
     }
 
-    fn speed(&mut self, key: &str, raw: Option<&RawSpeed>) -> Option<Speed> {
+    fn speed(&mut self, key: &str, raw: Option<&RawSpeed>, kind: Option<Kind>) -> Option<Speed> {
         let rpm_key = format!("{key}.rpm");
         let rpm_fix = "give the shaft speed in revolutions per minute under [sensors.speed], \
                        e.g. rpm = 1772";
@@ -578,37 +578,122 @@ impl Checker {
             return None;
         };
         let source_key = format!("{key}.source");
-        let source_fix = "use source = \"fixed\" with rpm = the shaft speed, e.g. rpm = 1772";
+        let source_fix = "use source = \"fixed\" with rpm = the shaft speed, \"can\" for the \
+                          sensor's speed frames, or \"estimate\" with rpm = the nominal speed";
         let source = self.or_default(&source_key, &raw.source, "fixed".to_string(), source_fix)?;
+        let speed_limits = Limits::between(0.0, 100_000.0);
+        // A key the chosen source does not read would be silently ignored: refuse it.
+        let unused = |check: &mut Self, name: &str, present: bool, readers: &str| {
+            if present {
+                check.problem(
+                    format!("{key}.{name}"),
+                    format!(
+                        "{name} is read only with {readers}, so with source = {source:?} it \
+                         would be ignored; remove it or change the source"
+                    ),
+                );
+            }
+        };
         match source.as_str() {
             "fixed" => {
+                unused(self, "max_rpm", raw.max_rpm.is_some(), "source = \"can\"");
+                unused(
+                    self,
+                    "search",
+                    raw.search.is_some(),
+                    "source = \"estimate\"",
+                );
                 let rpm = self.required(
                     &rpm_key,
                     &raw.rpm,
                     " (source = \"fixed\" needs the speed)",
                     rpm_fix,
                 )?;
-                let rpm =
-                    self.in_limits(&rpm_key, rpm, Limits::between(0.0, 100_000.0), rpm_fix)?;
-                Some(Speed::Fixed { rpm })
+                let rpm = self.in_limits(&rpm_key, rpm, speed_limits, rpm_fix)?;
+                (raw.max_rpm.is_none() && raw.search.is_none()).then_some(Speed::Fixed { rpm })
             }
-            "can" | "estimate" => {
-                self.problem(
-                    source_key,
-                    format!(
-                        "speed source {source:?} is not yet supported (reserved for a later \
-                         release); {source_fix}"
-                    ),
+            "can" => {
+                unused(
+                    self,
+                    "search",
+                    raw.search.is_some(),
+                    "source = \"estimate\"",
                 );
-                None
+                if kind == Some(Kind::Sim) {
+                    self.problem(
+                        &source_key,
+                        "the simulated sensor (transport = \"sim\") sends no speed frames; use \
+                         source = \"fixed\" or \"estimate\", or a \"can\" or \"shm\" sensor",
+                    );
+                }
+                let nominal_fix = "give the speed to assume until the first speed frame, e.g. \
+                                   rpm = 1772, or leave rpm out to score nothing until then";
+                let nominal = match self.get(&rpm_key, &raw.rpm, nominal_fix) {
+                    Got::Missing => Some(None),
+                    Got::Invalid => None,
+                    Got::Value(rpm) => self
+                        .in_limits(&rpm_key, rpm, speed_limits, nominal_fix)
+                        .map(Some),
+                };
+                let max_key = format!("{key}.max_rpm");
+                let max_fix = "give the highest shaft speed the machine runs at, e.g. max_rpm = \
+                               3600 (the envelope spectrum is sized for its fault harmonics)";
+                let max_rpm = match (self.get(&max_key, &raw.max_rpm, max_fix), nominal) {
+                    (Got::Value(max), _) => self.in_limits(&max_key, max, speed_limits, max_fix),
+                    (Got::Missing, Some(Some(rpm))) => Some(rpm * DEFAULT_MAX_RPM_FACTOR),
+                    (Got::Missing, Some(None)) => {
+                        self.problem(
+                            &max_key,
+                            format!(
+                                "missing: without a nominal rpm there is no default for the \
+                                 highest speed; {max_fix}"
+                            ),
+                        );
+                        None
+                    }
+                    _ => None,
+                };
+                let (nominal_rpm, max_rpm) = (nominal?, max_rpm?);
+                if let Some(rpm) = nominal_rpm.filter(|&rpm| rpm >= max_rpm) {
+                    self.problem(
+                        &max_key,
+                        format!(
+                            "max_rpm {max_rpm} is not above the nominal rpm {rpm}; raise max_rpm \
+                             or lower rpm"
+                        ),
+                    );
+                    return None;
+                }
+                (kind != Some(Kind::Sim) && raw.search.is_none()).then_some(Speed::Frames {
+                    nominal_rpm,
+                    max_rpm,
+                })
+            }
+            "estimate" => {
+                unused(self, "max_rpm", raw.max_rpm.is_some(), "source = \"can\"");
+                let rpm = self.required(
+                    &rpm_key,
+                    &raw.rpm,
+                    " (source = \"estimate\" searches near the nominal speed)",
+                    "give the nominal shaft speed in revolutions per minute, e.g. rpm = 1772",
+                )?;
+                let rpm = self.in_limits(&rpm_key, rpm, speed_limits, rpm_fix)?;
+                let search = self.number(
+                    &format!("{key}.search"),
+                    &raw.search,
+                    DEFAULT_SPEED_SEARCH,
+                    Limits::above_to(0.0, 0.3),
+                    "give the relative half-width of the search around rpm, e.g. search = 0.05 \
+                     for ±5 %",
+                )?;
+                raw.max_rpm
+                    .is_none()
+                    .then_some(Speed::Estimate { rpm, search })
             }
             other => {
                 self.problem(
                     source_key,
-                    format!(
-                        "unknown speed source {other:?} (\"fixed\" works now, \"can\" and \
-                         \"estimate\" are planned); {source_fix}"
-                    ),
+                    format!("unknown speed source {other:?}; {source_fix}"),
                 );
                 None
             }

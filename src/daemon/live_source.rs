@@ -5,10 +5,10 @@
 //! waits when the analysis queue is full, which pushes the loss back into the transport's own
 //! buffer, where it is counted as an exact sequence gap.
 
-use super::messages::ChannelId;
+use super::messages::{ChannelId, IngestMessage};
 use super::pipeline::Input;
 use crate::config::{Config, SensorConfig, Transport};
-use crate::ingest::IngestEvent;
+use crate::ingest::{IngestEvent, IngestStats};
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -28,7 +28,7 @@ impl NodeMap {
     }
 
     /// The pipeline's input for a source's event; `None` for events the pipeline does not
-    /// need (metadata, speed, malformed frames: counted by the source).
+    /// need (metadata, malformed frames: counted by the source).
     pub fn to_input(&self, event: IngestEvent) -> Option<Input> {
         let channel = |node: u8, axis: u8| {
             self.nodes.get(&node).and_then(|(sensor, axes)| {
@@ -58,6 +58,10 @@ impl NodeMap {
             }),
             IngestEvent::SensorBack { node } => Some(Input::SensorBack {
                 sensor: self.nodes.get(&node)?.0.clone(),
+            }),
+            IngestEvent::Speed { node, rpm, .. } => Some(Input::Speed {
+                sensor: self.nodes.get(&node)?.0.clone(),
+                rpm: rpm.map(f64::from),
             }),
             // A gap shows in the next block's first sample; the monitor reports it there.
             _ => None,
@@ -103,17 +107,51 @@ pub fn shm_sensors(config: &Config) -> Vec<(String, NodeMap)> {
         .collect()
 }
 
-/// Forwards a source's events to the analysis queue until either side ends.
+/// Forwards a source's events to the analysis queue until either side ends. Sample blocks of
+/// nodes or axes the config does not know are skipped and counted; the source's counters
+/// ([`IngestEvent::Stats`]) go on as [`Input::Ingest`] for the log, named `source`.
 pub async fn forward(
     mut events: tokio::sync::mpsc::Receiver<IngestEvent>,
     map: NodeMap,
+    source: String,
     inputs: tokio::sync::mpsc::Sender<Input>,
 ) {
+    let mut dropped_blocks = 0u64;
     while let Some(event) = events.recv().await {
-        if let Some(input) = map.to_input(event) {
+        let input = match event {
+            IngestEvent::Stats(stats) => Some(Input::Ingest(ingest_message(
+                &source,
+                &stats,
+                dropped_blocks,
+            ))),
+            IngestEvent::Samples(_) => {
+                let input = map.to_input(event);
+                dropped_blocks += u64::from(input.is_none());
+                input
+            }
+            other => map.to_input(other),
+        };
+        if let Some(input) = input {
             if inputs.send(input).await.is_err() {
                 return;
             }
         }
+    }
+}
+
+/// The logged form of a source's counters.
+pub fn ingest_message(source: &str, stats: &IngestStats, dropped_blocks: u64) -> IngestMessage {
+    IngestMessage {
+        source: source.to_string(),
+        frames: stats.frames,
+        samples: stats.samples,
+        gaps: stats.gaps,
+        missing_samples: stats.missing_samples,
+        malformed: stats.malformed.total(),
+        restarts: stats.restarts,
+        dropped_blocks,
+        speed_frames: stats.speed_frames,
+        sensor_lost: stats.sensor_lost,
+        handoff_dropped: stats.handoff_dropped,
     }
 }

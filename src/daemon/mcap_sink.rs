@@ -68,6 +68,7 @@ impl McapSink {
             PipelineMessage::Twin(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Flag(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Health(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Speed(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Ingest(_) => self.last_ns,
         }
     }

@@ -115,17 +115,45 @@ pub struct HealthMessage {
     pub detail: String,
 }
 
-/// Counters of one source, periodically. Topic `/ingest/<source>`.
+/// The shaft speed a channel uses from `end_sample` on (every speed frame, every estimate).
+/// Topic `/speed/<sensor>/<axis>`. A replay feeds the measured ones (`source = "can"`) back at
+/// their samples, so its flags equal the live run's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpeedMessage {
+    pub channel: ChannelId,
+    /// The sample from which the speed applies.
+    pub end_sample: u64,
+    /// `can` (a speed frame) or `estimate` (estimated from the spectrum).
+    pub source: String,
+    /// The speed as given: the frame's value (`null`: "not available") or the estimate, rpm.
+    pub given_rpm: Option<f64>,
+    /// The speed the channel scores with from here; `null` when the given one is not usable
+    /// (not available, 0, above `max_rpm`): the channel then scores nothing.
+    pub rpm: Option<f64>,
+}
+
+/// Counters of one source since the daemon started, every `outputs.status_interval_s` and
+/// when the source stops. Topic `/ingest/<source>`, `<source>` `can-<interface>` or
+/// `shm-<sensor>`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct IngestMessage {
     pub source: String,
+    /// Frames received, valid or not.
     pub frames: u64,
+    /// Samples delivered in blocks.
     pub samples: u64,
     pub gaps: u64,
+    /// Samples the nodes sent that never arrived (the gaps' sizes).
     pub missing_samples: u64,
+    /// Frames refused (every kind; `bearingd ingest --json` shows them by kind).
     pub malformed: u64,
     pub restarts: u64,
+    /// Sample blocks of nodes or axes the config does not know, skipped.
     pub dropped_blocks: u64,
+    pub speed_frames: u64,
+    pub sensor_lost: u64,
+    /// Transport batches dropped at a full hand-off queue (iceoryx2; also visible as gaps).
+    pub handoff_dropped: u64,
 }
 
 /// Everything the pipeline emits, in the order it emits it.
@@ -138,4 +166,5 @@ pub enum PipelineMessage {
     Flag(FlagMessage),
     Health(HealthMessage),
     Ingest(IngestMessage),
+    Speed(SpeedMessage),
 }

@@ -7,15 +7,16 @@
 //! samples gives the same flags at the same samples.
 
 use super::messages::{
-    ChannelId, FlagMessage, HealthMessage, IndicatorsMessage, PipelineMessage, RawBlock,
-    SpectrumMessage,
+    ChannelId, FlagMessage, HealthMessage, IndicatorsMessage, IngestMessage, PipelineMessage,
+    RawBlock, SpectrumMessage, SpeedMessage,
 };
 use crate::analysis::flags::{FlagLevel, FlagSettings};
 use crate::analysis::health::{Baseline, HealthStage};
-use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
+use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings, SpeedMode};
+use crate::analysis::speed::SpeedSearch;
 use crate::analysis::{Band, FaultKind};
 use crate::bearing::FaultFrequencies;
-use crate::config::{Config, SensorConfig};
+use crate::config::{Config, SensorConfig, Speed};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -41,6 +42,17 @@ pub enum Input {
         channel: ChannelId,
         first_sample: u64,
     },
+    /// A speed frame of the sensor (`rpm` `None`: "not available"). It takes effect at each
+    /// of the sensor's channels at the sample that channel has reached; ignored unless the
+    /// sensor's speed source is `can`.
+    Speed {
+        sensor: String,
+        rpm: Option<f64>,
+    },
+    /// A logged measured speed (a replay): takes effect at its own sample.
+    LoggedSpeed(SpeedMessage),
+    /// A live source's counters, passed on to the sinks (the log) in order with the data.
+    Ingest(IngestMessage),
 }
 
 /// A request for the twin's re-fit, handed to the re-fit thread.
@@ -66,7 +78,10 @@ pub enum Output {
 #[derive(Debug, Clone, Serialize)]
 pub struct ChannelStatus {
     pub channel: ChannelId,
-    pub rpm: f64,
+    /// The speed the channel scores with; `None` while it has none (see `speed_source`).
+    pub rpm: Option<f64>,
+    /// `fixed`, `can` or `estimate`.
+    pub speed_source: &'static str,
     pub samples: u64,
     pub seconds: f64,
     pub band_hz: Option<[f64; 2]>,
@@ -122,6 +137,20 @@ pub fn monitor_settings(config: &Config, sensor: &SensorConfig) -> MonitorSettin
         sigma: t.sigma,
         clip_count: i32::from(i16::MAX),
         flat_line_samples: samples(1.0),
+        speed: match sensor.speed {
+            Speed::Fixed { .. } => SpeedMode::Fixed,
+            Speed::Frames {
+                nominal_rpm,
+                max_rpm,
+            } => SpeedMode::Given {
+                known_at_start: nominal_rpm.is_some(),
+                max_shaft_hz: max_rpm / 60.0,
+            },
+            Speed::Estimate { rpm, search } => SpeedMode::Estimate(SpeedSearch {
+                nominal_hz: rpm / 60.0,
+                range: search,
+            }),
+        },
     }
 }
 
@@ -136,12 +165,42 @@ pub fn band_history_s(config: &Config) -> f64 {
 
 const MAX_BAND_HISTORY_S: f64 = 10.0;
 
+impl Channel {
+    /// A speed given from outside, at `at_sample` of this channel.
+    fn speed_at(
+        &mut self,
+        id: &ChannelId,
+        at_sample: u64,
+        rpm: Option<f64>,
+        spectrum_every_s: f64,
+        out: &mut impl FnMut(Output),
+    ) {
+        let fs = self.fs_hz;
+        let Channel {
+            monitor,
+            status,
+            next_spectrum,
+            ..
+        } = self;
+        monitor.set_speed_at(at_sample, rpm.map(|r| r / 60.0), &mut |event| {
+            handle_event(id, fs, spectrum_every_s, next_spectrum, status, event, out)
+        });
+        self.status.flags = self.monitor.flag_levels();
+    }
+}
+
 impl Pipeline {
     /// One monitor per (sensor, axis); `baselines` resumes health stages kept across restarts.
     pub fn new(config: &Config, baselines: &BTreeMap<ChannelId, Baseline>) -> Self {
         let mut channels = BTreeMap::new();
         for sensor in &config.sensors {
-            let freqs = sensor.bearing.fault_frequencies(sensor.speed.shaft_hz());
+            // Without a starting speed the channel waits (nothing is scored); its frequencies
+            // are then those at the highest speed, for sizing only.
+            let start_rpm = sensor
+                .speed
+                .initial_rpm()
+                .unwrap_or_else(|| sensor.speed.max_rpm());
+            let freqs = sensor.bearing.fault_frequencies(start_rpm / 60.0);
             for axis in &sensor.axes {
                 let id = ChannelId {
                     sensor: sensor.id.clone(),
@@ -154,7 +213,8 @@ impl Pipeline {
                 );
                 let status = ChannelStatus {
                     channel: id.clone(),
-                    rpm: sensor.speed.shaft_hz() * 60.0,
+                    rpm: monitor.shaft_hz().map(|hz| hz * 60.0),
+                    speed_source: sensor.speed.source_name(),
                     samples: 0,
                     seconds: 0.0,
                     band_hz: None,
@@ -266,7 +326,7 @@ impl Pipeline {
                 if c.monitor.bands().is_none() {
                     c.status.band_hz = None;
                 }
-                if let Some(bands) = c.monitor.bands() {
+                if let Some(bands) = c.monitor.bands().filter(|_| c.monitor.shaft_hz().is_some()) {
                     if c.monitor.next_sample() >= c.next_twin {
                         c.next_twin = c.monitor.next_sample() + (twin_period_s * fs) as u64;
                         out(Output::Twin(TwinRequest {
@@ -280,6 +340,32 @@ impl Pipeline {
                     }
                 }
             }
+            Input::Speed { sensor, rpm } => {
+                let spectrum_every_s = self.spectrum_every_s;
+                for (id, c) in self
+                    .channels
+                    .iter_mut()
+                    .filter(|(id, _)| id.sensor == sensor)
+                {
+                    let at = c.monitor.next_sample();
+                    c.speed_at(id, at, rpm, spectrum_every_s, out);
+                }
+            }
+            Input::LoggedSpeed(logged) => {
+                let spectrum_every_s = self.spectrum_every_s;
+                if logged.source == "can" {
+                    if let Some(c) = self.channels.get_mut(&logged.channel) {
+                        c.speed_at(
+                            &logged.channel,
+                            logged.end_sample,
+                            logged.given_rpm,
+                            spectrum_every_s,
+                            out,
+                        );
+                    }
+                }
+            }
+            Input::Ingest(message) => out(Output::Message(PipelineMessage::Ingest(message))),
             Input::SensorLost { sensor } => self.sensor_event(&sensor, true, out),
             Input::SensorBack { sensor } => self.sensor_event(&sensor, false, out),
             Input::Restart {
@@ -356,7 +442,7 @@ fn handle_event(
             PipelineMessage::Indicators(IndicatorsMessage {
                 channel: channel.clone(),
                 end_sample: w.end_sample,
-                rpm: status.rpm,
+                rpm: status.rpm.unwrap_or(f64::NAN),
                 band_hz: [w.bands[top].lo_hz, w.bands[top].hi_hz],
                 rms: w.indicators.rms,
                 peak: w.indicators.peak,
@@ -418,6 +504,21 @@ fn handle_event(
                 detail: format!(
                     "{missing} samples missing; the analysis windows restart after the gap"
                 ),
+            })
+        }
+        MonitorEvent::Speed {
+            at_sample,
+            shaft_hz,
+            given_hz,
+            estimated,
+        } => {
+            status.rpm = shaft_hz.map(|hz| hz * 60.0);
+            PipelineMessage::Speed(SpeedMessage {
+                channel: channel.clone(),
+                end_sample: at_sample,
+                source: if estimated { "estimate" } else { "can" }.into(),
+                given_rpm: given_hz.map(|hz| hz * 60.0),
+                rpm: shaft_hz.map(|hz| hz * 60.0),
             })
         }
         MonitorEvent::Bands {

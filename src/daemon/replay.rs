@@ -2,6 +2,9 @@
 //! run, as fast as possible or at a chosen speed, into the same sinks. Truncated files are read
 //! up to their last complete chunk, and the summary says how much could not be read.
 //!
+//! Logged speed frames (`/speed/…` with source `can`) are fed back at their samples, so a
+//! channel whose speed comes from speed frames sees the same speeds at the same samples.
+//!
 //! The twin's re-fits run inline here (the live run does them on their own thread): they do
 //! not influence flags, so the flags of a replay equal the live run's at the same samples.
 
@@ -85,8 +88,21 @@ pub fn replay(
                 continue;
             }
         };
-        let PipelineMessage::Raw(block) = logged.message else {
-            continue;
+        let block = match logged.message {
+            PipelineMessage::Raw(block) => block,
+            // Measured speeds are inputs like the raw samples; the pipeline uses them if the
+            // sensor's speed source is `can`, at their logged samples.
+            PipelineMessage::Speed(speed) => {
+                let mut outputs = Vec::new();
+                pipeline.handle(Input::LoggedSpeed(speed), &mut |output| {
+                    outputs.push(output)
+                });
+                for output in outputs {
+                    emit(output, sinks, &mut flags, &mut worker);
+                }
+                continue;
+            }
+            _ => continue,
         };
         if !known.contains(&block.channel) {
             let name = block.channel.to_string();

@@ -424,6 +424,8 @@ fn start_live_sources(
     tasks: &mut tokio::task::JoinSet<()>,
 ) -> Result<bool, RunError> {
     let mut any = false;
+    // Each source's counters go to the log (`/ingest/<source>`) at the status interval.
+    let status_interval = std::time::Duration::from_secs_f64(config.outputs.status_interval_s);
     let stopped = |mut stop: tokio::sync::watch::Receiver<bool>| async move {
         let _ = stop.wait_for(|s| *s).await;
     };
@@ -438,6 +440,7 @@ fn start_live_sources(
                 receive_buffer_bytes: 4 << 20,
                 capture: None,
                 capture_frames: 0,
+                stats_interval: Some(status_interval),
             })
             .map_err(|e| RunError::Source(e.to_string()))?;
             let (events_tx, events_rx) = tokio::sync::mpsc::channel(ANALYSIS_QUEUE);
@@ -447,7 +450,12 @@ fn start_live_sources(
                     eprintln!("bearingd: CAN source stopped: {e}");
                 }
             });
-            tasks.spawn(forward(events_rx, map, inputs.clone()));
+            tasks.spawn(forward(
+                events_rx,
+                map,
+                format!("can-{interface}"),
+                inputs.clone(),
+            ));
         }
         #[cfg(not(feature = "can"))]
         {
@@ -471,15 +479,17 @@ fn start_live_sources(
                 silence_timeout: SENSOR_TIMEOUT,
                 handoff_capacity: 64,
                 when_full: WhenFull::DropOldest,
+                stats_interval: Some(status_interval),
             };
             let (events_tx, events_rx) = tokio::sync::mpsc::channel(ANALYSIS_QUEUE);
             let shutdown = stopped(stop.clone());
+            let name = format!("shm-{sensor}");
             tasks.spawn(async move {
                 if let Err(e) = shm::run(source, events_tx, shutdown).await {
                     eprintln!("bearingd: iceoryx2 source bearingd/accel/{sensor} stopped: {e}");
                 }
             });
-            tasks.spawn(forward(events_rx, map, inputs.clone()));
+            tasks.spawn(forward(events_rx, map, name, inputs.clone()));
         }
         #[cfg(not(feature = "shm"))]
         {
@@ -574,11 +584,17 @@ pub fn status_line(s: &ChannelStatus) -> String {
         .filter(|(_, l)| l.name() != "ok")
         .map(|(k, l)| format!("{}={}", k.name(), l.name()))
         .collect();
+    let rpm = match (s.rpm, s.speed_source) {
+        (Some(rpm), "fixed") => format!("{rpm:.0}"),
+        (Some(rpm), source) => format!("{rpm:.0}({source})"),
+        (None, "estimate") => "?(no estimate yet: scoring waits)".to_string(),
+        (None, _) => "?(no usable speed frame: scoring waits)".to_string(),
+    };
     format!(
-        "{} t={:.1}s rpm={:.0} band={} top={} twin={} stage={} flags={}{}",
+        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} flags={}{}",
         s.channel,
         s.seconds,
-        s.rpm,
+        rpm,
         band,
         top,
         twin,

@@ -31,7 +31,10 @@ impl SimSource {
             .map(|(i, axis)| {
                 let params = SimulationParams {
                     fault,
-                    rpm: sensor.speed.shaft_hz() * 60.0,
+                    rpm: sensor
+                        .speed
+                        .initial_rpm()
+                        .unwrap_or_else(|| sensor.speed.max_rpm()),
                     bearing: sensor.bearing.clone(),
                     fs_hz: sensor.sample_rate_hz,
                     amplitude_g: sim.severity,

@@ -118,6 +118,9 @@ pub enum IngestEvent {
         /// The decoder's message (names the frame id and byte offset).
         detail: String,
     },
+    /// The source's counters so far; periodically and when it stops, if the source was asked
+    /// to (the daemon logs them). Not made by the assembler.
+    Stats(IngestStats),
 }
 
 /// Where a speed value comes from.

@@ -9,7 +9,9 @@
 //! Frames are read one by one when the socket is quiet and drained in batches of up to
 //! [`READ_BATCH`] when it is busy, so the assembler merges a batch into one block per stream.
 
-use super::{node_of, Assembler, EventSender, IngestEvent, SilenceWatch, SourceSummary};
+use super::{
+    node_of, Assembler, EventSender, IngestEvent, SilenceWatch, SourceSummary, StatsTimer,
+};
 use socketcan::tokio::CanFdSocket;
 use socketcan::{CanAnyFrame, CanFilter, EmbeddedFrame, Frame, SocketOptions};
 use std::future::Future;
@@ -33,6 +35,8 @@ pub struct CanSourceConfig {
     /// writer (for checking what was on the bus with standard tools such as cantools).
     pub capture: Option<Box<dyn Write + Send>>,
     pub capture_frames: usize,
+    /// Report the counters ([`IngestEvent::Stats`]) this often and when stopping; `None`: never.
+    pub stats_interval: Option<Duration>,
 }
 
 /// Why the CAN source could not run.
@@ -106,6 +110,7 @@ impl CanSource {
         let mut tick = tokio::time::interval((watch.timeout() / 4).max(Duration::from_millis(10)));
         tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
         let mut captured = 0usize;
+        let mut stats = StatsTimer::new(self.config.stats_interval);
         tokio::pin!(shutdown);
         loop {
             tokio::select! {
@@ -126,6 +131,7 @@ impl CanSource {
                     }
                 }
                 _ = tick.tick() => watch.check(Instant::now(), &mut assembler, &mut out),
+                () = stats.tick() => out.push(IngestEvent::Stats(assembler.stats())),
             }
             for event in out.drain(..) {
                 if events.send(event).await.is_err() {
@@ -135,6 +141,10 @@ impl CanSource {
         }
         if let Some(capture) = self.config.capture.as_mut() {
             let _ = capture.flush();
+        }
+        if stats.enabled() {
+            // The final counters; a consumer already gone needs none.
+            let _ = events.send(IngestEvent::Stats(assembler.stats())).await;
         }
         Ok(summary(&assembler))
     }

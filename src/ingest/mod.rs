@@ -85,3 +85,31 @@ pub fn node_of(can_id: u32) -> Option<u8> {
 /// Where a source's events go: bounded; a full channel makes the source wait (see the module
 /// docs for why waiting here is the policy that never loses samples silently).
 pub type EventSender = tokio::sync::mpsc::Sender<IngestEvent>;
+
+/// When a source reports its counters ([`IngestEvent::Stats`]): every `every`, with tokio's
+/// clock; never when `every` is `None`.
+pub struct StatsTimer(Option<tokio::time::Interval>);
+
+impl StatsTimer {
+    pub fn new(every: Option<Duration>) -> StatsTimer {
+        StatsTimer(every.filter(|d| !d.is_zero()).map(|every| {
+            let mut interval = tokio::time::interval_at(Instant::now() + every, every);
+            interval.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+            interval
+        }))
+    }
+
+    pub fn enabled(&self) -> bool {
+        self.0.is_some()
+    }
+
+    /// Resolves at the next report time (never when disabled).
+    pub async fn tick(&mut self) {
+        match &mut self.0 {
+            Some(interval) => {
+                interval.tick().await;
+            }
+            None => std::future::pending().await,
+        }
+    }
+}

@@ -18,7 +18,9 @@
 
 use super::handoff::{self, WhenFull};
 use super::payload::FrameBatch;
-use super::{node_of, Assembler, EventSender, IngestEvent, SilenceWatch, SourceSummary};
+use super::{
+    node_of, Assembler, EventSender, IngestEvent, SilenceWatch, SourceSummary, StatsTimer,
+};
 use iceoryx2::port::backpressure_strategy::BackpressureStrategy;
 use iceoryx2::prelude::*;
 use std::future::Future;
@@ -160,6 +162,8 @@ pub struct ShmSourceConfig {
     pub handoff_capacity: usize,
     /// `DropOldest` for live sensors; `Block` to push back into iceoryx2 instead.
     pub when_full: WhenFull,
+    /// Report the counters ([`IngestEvent::Stats`]) this often and when stopping; `None`: never.
+    pub stats_interval: Option<Duration>,
 }
 
 /// Starts the port thread, waits until its ports exist, then runs until `shutdown`, the
@@ -200,6 +204,7 @@ pub async fn run(
     let mut out: Vec<IngestEvent> = Vec::with_capacity(64);
     let mut tick = tokio::time::interval((watch.timeout() / 4).max(Duration::from_millis(10)));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut stats = StatsTimer::new(config.stats_interval);
     tokio::pin!(shutdown);
     loop {
         tokio::select! {
@@ -222,6 +227,7 @@ pub async fn run(
                 }
             }
             _ = tick.tick() => watch.check(Instant::now(), &mut assembler, &mut out),
+            () = stats.tick() => out.push(IngestEvent::Stats(assembler.stats())),
         }
         for event in out.drain(..) {
             if events.send(event).await.is_err() {
@@ -235,6 +241,10 @@ pub async fn run(
     stop_thread();
     drop(consumer);
     let _ = tokio::task::spawn_blocking(move || thread.join()).await;
+    if stats.enabled() {
+        // The final counters; a consumer already gone needs none.
+        let _ = events.send(IngestEvent::Stats(assembler.stats())).await;
+    }
     Ok(summary(&assembler))
 }
 

@@ -241,6 +241,7 @@ fn decode_json(kind: JsonKind, data: &[u8]) -> serde_json::Result<PipelineMessag
         JsonKind::Flag => PipelineMessage::Flag(serde_json::from_slice(data)?),
         JsonKind::Health => PipelineMessage::Health(serde_json::from_slice(data)?),
         JsonKind::Ingest => PipelineMessage::Ingest(serde_json::from_slice(data)?),
+        JsonKind::Speed => PipelineMessage::Speed(serde_json::from_slice(data)?),
     })
 }
 

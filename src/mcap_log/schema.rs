@@ -143,16 +143,18 @@ pub enum JsonKind {
     Flag,
     Health,
     Ingest,
+    Speed,
 }
 
 impl JsonKind {
-    pub const ALL: [JsonKind; 6] = [
+    pub const ALL: [JsonKind; 7] = [
         JsonKind::Spectrum,
         JsonKind::Indicators,
         JsonKind::Twin,
         JsonKind::Flag,
         JsonKind::Health,
         JsonKind::Ingest,
+        JsonKind::Speed,
     ];
 
     /// The schema name recorded in the file (also Foxglove's datatype name).
@@ -164,6 +166,7 @@ impl JsonKind {
             JsonKind::Flag => "bearingd.Flag",
             JsonKind::Health => "bearingd.Health",
             JsonKind::Ingest => "bearingd.Ingest",
+            JsonKind::Speed => "bearingd.Speed",
         }
     }
 
@@ -233,7 +236,15 @@ impl JsonKind {
                 json!({
                     "source": string(), "frames": uint(), "samples": uint(), "gaps": uint(),
                     "missing_samples": uint(), "malformed": uint(), "restarts": uint(),
-                    "dropped_blocks": uint()
+                    "dropped_blocks": uint(), "speed_frames": uint(), "sensor_lost": uint(),
+                    "handoff_dropped": uint()
+                }),
+            ),
+            JsonKind::Speed => (
+                "bearingd.Speed",
+                json!({
+                    "channel": channel(), "end_sample": uint(), "source": string(),
+                    "given_rpm": num(), "rpm": num()
                 }),
             ),
         };

@@ -592,6 +592,10 @@ fn encode(
             let _ = write!(topic, "/ingest/{}", m.source);
             (JsonKind::Ingest, serde_json::to_writer(&mut *payload, m))
         }
+        PipelineMessage::Speed(m) => {
+            let _ = write!(topic, "/speed/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Speed, serde_json::to_writer(&mut *payload, m))
+        }
     };
     debug_assert!(r.is_ok());
     Some(kind)

@@ -178,7 +178,9 @@ fn a_config_error_refuses_to_start_and_lists_every_problem() {
 
 /// The firmware simulator as a separate process publishing over iceoryx2, `bearingd run`
 /// subscribing, logging to MCAP; then a replay of that log raises the same flags at the same
-/// samples.
+/// samples. The speed comes from the node's speed frames (no nominal speed: nothing is scored
+/// before the first), is logged and fed back by the replay; the source's counters are logged
+/// at the status interval and read back by Python.
 #[test]
 fn a_simulated_node_over_iceoryx2_through_the_daemon_and_its_replay_give_the_same_flags() {
     let dir = scratch_dir("daemon-iox");
@@ -197,12 +199,13 @@ scale_g_per_count = 0.00048828125
 axes = ["radial"]
 bearing = "skf-6205-2rs"
 [sensors.speed]
-source = "fixed"
-rpm = 1772
+source = "can"
+max_rpm = 2500
 [sensors.shm]
 service = "bearingd/accel/node1"
 
 [outputs]
+status_interval_s = 2
 state_dir = "{state}"
 mcap_dir = "{mcap}"
 iceoryx2_root = "{iox}"
@@ -304,6 +307,52 @@ iceoryx2_root = "{iox}"
             .all(|f| f.1 == "outer_race" && f.4 > 20 * 25_600),
         "{live_flags:?}"
     );
+
+    // The speed frames (one per second of sample time, 1772 rpm) were used and logged.
+    let speeds: Vec<(u64, Option<f64>)> = read_messages(&live)
+        .filter_map(|m| match m.unwrap().message {
+            PipelineMessage::Speed(s) => Some((s.end_sample, s.rpm)),
+            _ => None,
+        })
+        .collect();
+    assert!(speeds.len() >= 50, "{speeds:?}");
+    assert_eq!(speeds[0], (0, Some(1772.0)), "{speeds:?}");
+    assert!(speeds.iter().all(|s| s.1 == Some(1772.0)), "{speeds:?}");
+    // The source's counters, periodically and at the end: every sample, no loss.
+    let ingest: Vec<_> = read_messages(&live)
+        .filter_map(|m| match m.unwrap().message {
+            PipelineMessage::Ingest(i) => Some(i),
+            _ => None,
+        })
+        .collect();
+    assert!(ingest.len() >= 5, "{ingest:?}");
+    let last = ingest.last().unwrap();
+    assert_eq!(last.source, "shm-node1");
+    assert_eq!(last.samples, 60 * 25_600, "{last:?}");
+    assert!(last.speed_frames >= 60, "{last:?}");
+    assert_eq!(
+        (
+            last.gaps,
+            last.missing_samples,
+            last.malformed,
+            last.dropped_blocks
+        ),
+        (0, 0, 0, 0),
+        "{last:?}"
+    );
+    assert!(ingest.windows(2).all(|w| w[0].frames <= w[1].frames));
+    if let Some(py) = python_mcap() {
+        let summary = check_mcap_with_python(&py, &live[0], None);
+        let topics = &summary["topics"];
+        assert!(
+            topics["/ingest/shm-node1"].as_u64().unwrap_or(0) >= 5,
+            "{summary}"
+        );
+        assert!(
+            topics["/speed/node1/radial"].as_u64().unwrap_or(0) >= 50,
+            "{summary}"
+        );
+    }
 
     let replay_dir = dir.join("replay");
     let out = bearingd(&[

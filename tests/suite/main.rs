@@ -8,4 +8,5 @@ mod developer_set;
 mod envelope;
 mod kinematics;
 mod monitor;
+mod speed;
 mod twin;

@@ -4,7 +4,7 @@
 
 use bearingd::analysis::flags::{FlagLevel, FlagSettings};
 use bearingd::analysis::health::HealthStage;
-use bearingd::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
+use bearingd::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings, SpeedMode};
 use bearingd::analysis::AnalysisSettings;
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 
@@ -27,6 +27,7 @@ fn settings(fs: f64) -> MonitorSettings {
         sigma: 3.0,
         clip_count: 32_767,
         flat_line_samples: fs as u64,
+        speed: SpeedMode::Fixed,
     }
 }
 
@@ -48,45 +49,75 @@ fn counts(seconds: f64, onset_s: f64) -> (Vec<i16>, SimulationParams) {
 
 /// Events as comparable text lines.
 fn run(counts: &[i16], params: &SimulationParams, block: usize) -> Vec<String> {
-    let mut monitor = ChannelMonitor::new(settings(params.fs_hz), params.frequencies(), None);
+    let monitor = ChannelMonitor::new(settings(params.fs_hz), params.frequencies(), None);
+    run_monitor(monitor, counts, block, &[])
+}
+
+/// Events as text lines; `speeds` (sample, shaft Hz) are given before the first block, each
+/// waiting for its sample (only one may wait: pass them in order, one per call at the block
+/// that reaches the previous one).
+fn run_monitor(
+    mut monitor: ChannelMonitor,
+    counts: &[i16],
+    block: usize,
+    speeds: &[(u64, Option<f64>)],
+) -> Vec<String> {
     let mut events = Vec::new();
     let mut at = 0;
+    let mut speeds = speeds.iter().peekable();
     for chunk in counts.chunks(block) {
-        monitor.push_counts(at as u64, chunk, SCALE, &mut |event| match event {
-            MonitorEvent::Flag {
-                fault,
-                change,
-                score,
-                ..
-            } => events.push(format!(
-                "flag {} {:?}->{:?} at {} score {score:.3}",
-                fault.name(),
-                change.from,
-                change.to,
-                change.at_sample
-            )),
-            MonitorEvent::Stage(change) => {
-                events.push(format!("stage {:?} at {}", change.to, change.at_sample))
+        // Hand over the next speed change in the block that reaches its sample.
+        if let Some(&&(sample, hz)) = speeds.peek() {
+            if sample < (at + chunk.len()) as u64 {
+                monitor.set_speed_at(sample, hz, &mut |e| describe(e, &mut events));
+                speeds.next();
             }
-            MonitorEvent::Bands {
-                at_sample, bands, ..
-            } => events.push(format!("bands at {at_sample}: {bands:?}")),
-            MonitorEvent::Sensor {
-                condition,
-                active,
-                at_sample,
-            } => events.push(format!(
-                "sensor {} {active} at {at_sample}",
-                condition.name()
-            )),
-            MonitorEvent::Gap { at_sample, missing } => {
-                events.push(format!("gap {missing} at {at_sample}"))
-            }
-            MonitorEvent::Window(_) => {}
-        });
+        }
+        monitor.push_counts(at as u64, chunk, SCALE, &mut |e| describe(e, &mut events));
         at += chunk.len();
     }
     events
+}
+
+/// A monitor event as a comparable text line (windows are left out).
+fn describe(event: MonitorEvent, events: &mut Vec<String>) {
+    match event {
+        MonitorEvent::Flag {
+            fault,
+            change,
+            score,
+            ..
+        } => events.push(format!(
+            "flag {} {:?}->{:?} at {} score {score:.3}",
+            fault.name(),
+            change.from,
+            change.to,
+            change.at_sample
+        )),
+        MonitorEvent::Stage(change) => {
+            events.push(format!("stage {:?} at {}", change.to, change.at_sample))
+        }
+        MonitorEvent::Bands {
+            at_sample, bands, ..
+        } => events.push(format!("bands at {at_sample}: {bands:?}")),
+        MonitorEvent::Sensor {
+            condition,
+            active,
+            at_sample,
+        } => events.push(format!(
+            "sensor {} {active} at {at_sample}",
+            condition.name()
+        )),
+        MonitorEvent::Gap { at_sample, missing } => {
+            events.push(format!("gap {missing} at {at_sample}"))
+        }
+        MonitorEvent::Speed {
+            at_sample,
+            shaft_hz,
+            ..
+        } => events.push(format!("speed {shaft_hz:?} at {at_sample}")),
+        MonitorEvent::Window(_) => {}
+    }
 }
 
 #[test]
@@ -172,4 +203,119 @@ fn gaps_are_reported_and_never_bridged_and_a_flat_line_is_seen() {
     assert!(flat[0].0 && !flat[1].0);
     assert_eq!(flat[1].1, (14 * fs) as u64);
     assert_eq!(monitor.flag_levels(), [FlagLevel::Ok; 4]);
+}
+
+/// A channel whose speed comes from speed frames and has no nominal speed scores nothing, and
+/// selects no band, until the first usable speed; then it selects its bands at once and raises
+/// the outer-race flag. A speed above the maximum or "not available" makes it wait again (its
+/// flag holds). The same speeds in other block sizes give the same events at the same samples.
+#[test]
+fn a_given_speed_takes_effect_at_its_sample_and_without_one_nothing_is_scored() {
+    let (counts, params) = counts(70.0, 0.0);
+    let fs = params.fs_hz;
+    let shaft = params.rpm / 60.0;
+    let mode = SpeedMode::Given {
+        known_at_start: false,
+        max_shaft_hz: shaft * 1.5,
+    };
+    let monitor = || {
+        let mut s = settings(fs);
+        s.speed = mode;
+        // Started at the highest speed, for sizing; unknown until told.
+        ChannelMonitor::new(s, params.bearing.fault_frequencies(shaft * 1.5), None)
+    };
+    let at = |seconds: f64| (seconds * fs) as u64;
+    let speeds = [
+        (at(15.0), Some(shaft)),
+        (at(50.0), Some(shaft * 2.0)),
+        (at(55.0), None),
+        (at(60.0), Some(shaft)),
+    ];
+    let reference = run_monitor(monitor(), &counts, 4_096, &speeds);
+    let first_bands = reference
+        .iter()
+        .position(|e| e.starts_with("bands"))
+        .expect("bands selected");
+    assert!(
+        reference[first_bands].starts_with(&format!("bands at {}", at(15.0))),
+        "{reference:#?}"
+    );
+    assert!(
+        reference[..first_bands]
+            .iter()
+            .all(|e| !e.starts_with("flag")),
+        "{reference:#?}"
+    );
+    let flags: Vec<&String> = reference.iter().filter(|e| e.starts_with("flag")).collect();
+    assert!(
+        flags.iter().any(|f| f.starts_with("flag outer_race Ok->")),
+        "{reference:#?}"
+    );
+    assert!(
+        flags.iter().all(|f| f.starts_with("flag outer_race")),
+        "{flags:#?}"
+    );
+    // No flag change while the speed is unusable (50..60 s): flags hold.
+    let unusable = reference
+        .iter()
+        .skip_while(|e| !e.starts_with(&format!("speed None at {}", at(50.0))))
+        .take_while(|e| !e.starts_with(&format!("speed Some({shaft}) at {}", at(60.0))))
+        .filter(|e| e.starts_with("flag"))
+        .count();
+    assert_eq!(unusable, 0, "{reference:#?}");
+    assert!(reference.contains(&format!("speed None at {}", at(55.0))));
+    for block in [1_000, 12_000] {
+        assert_eq!(
+            run_monitor(monitor(), &counts, block, &speeds),
+            reference,
+            "block size {block}"
+        );
+    }
+}
+
+/// An estimating channel (nominal speed 3 % off) estimates the speed at its first band
+/// selection, before any score, and then raises the outer-race flag as with the true speed.
+#[test]
+fn an_estimating_channel_finds_the_speed_before_it_scores() {
+    let (counts, params) = counts(40.0, 0.0);
+    let fs = params.fs_hz;
+    let shaft = params.rpm / 60.0;
+    let mut s = settings(fs);
+    s.speed = SpeedMode::Estimate(bearingd::analysis::speed::SpeedSearch {
+        nominal_hz: shaft * 1.03,
+        range: 0.05,
+    });
+    let monitor = ChannelMonitor::new(s, params.bearing.fault_frequencies(shaft * 1.03), None);
+    let events = run_monitor(monitor, &counts, 4_096, &[]);
+    let first_speed = events
+        .iter()
+        .position(|e| e.starts_with("speed"))
+        .expect("an estimate");
+    let estimated: f64 = events[first_speed]
+        .trim_start_matches("speed Some(")
+        .split(')')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(
+        (estimated / shaft - 1.0).abs() < 0.005,
+        "{estimated} Hz for {shaft} Hz"
+    );
+    assert!(events[first_speed + 1].starts_with("bands"), "{events:#?}");
+    assert!(
+        events[..first_speed].iter().all(|e| !e.starts_with("flag")),
+        "{events:#?}"
+    );
+    assert!(
+        events.iter().any(|e| e.starts_with("flag outer_race Ok->")),
+        "{events:#?}"
+    );
+    assert!(
+        events
+            .iter()
+            .filter(|e| e.starts_with("flag"))
+            .all(|e| e.starts_with("flag outer_race")),
+        "{events:#?}"
+    );
 }

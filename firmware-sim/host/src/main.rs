@@ -108,6 +108,10 @@ struct Args {
     /// Seconds of sample time to send.
     #[arg(long, default_value_t = 10.0)]
     duration: f64,
+    /// A speed frame (tachometer, --rpm) from every node every S seconds of sample time, the
+    /// first before the first sample; 0 = none.
+    #[arg(long, value_name = "S", default_value_t = 1.0)]
+    speed_every: f64,
     /// Sample time runs this many times faster than real time; 0 = as fast as the bus allows.
     #[arg(long, default_value_t = 1.0)]
     speed_factor: f64,
@@ -236,6 +240,8 @@ fn run(args: &Args) -> Result<(), SimError> {
     let started = Instant::now();
     let mut done = 0u64;
     let mut next_speed = 0u64;
+    // Samples between speed frames (0: none); a speed frame goes out at a chunk's start.
+    let speed_period = (args.speed_every.max(0.0) * f64::from(fs)).round() as u64;
     while done < total {
         let mut n = chunk.min(total - done);
         if let Some(at) = args.restart_at_sample {
@@ -250,9 +256,9 @@ fn run(args: &Args) -> Result<(), SimError> {
             }
         }
         clock.wait_for_sample(done);
-        let send_speed = done >= next_speed;
+        let send_speed = speed_period > 0 && done >= next_speed;
         if send_speed {
-            next_speed += u64::from(fs);
+            next_speed += speed_period;
         }
         for (k, node) in nodes.iter_mut().enumerate() {
             if send_speed {

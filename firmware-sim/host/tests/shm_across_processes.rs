@@ -57,6 +57,7 @@ fn zero_loss_over_a_million_samples_per_stream() {
         silence_timeout: Duration::from_secs(5),
         handoff_capacity: 16,
         when_full: WhenFull::Block,
+        stats_interval: None,
     };
     let summary = runtime.block_on(async move {
         let source = tokio::spawn(shm::run(config, events_tx, async move {
