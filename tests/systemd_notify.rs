@@ -34,7 +34,13 @@ status_interval_s = 0.5
 "#,
         state = dir.join("state").display(),
         mcap = dir.join("mcap").display(),
-        iox = dir.join("iceoryx2").display(),
+        // iceoryx2's root for the alert service: not under /tmp (the config refuses it).
+        iox = Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!(
+                "iox-notify-{}",
+                dir.file_name().unwrap_or_default().to_string_lossy()
+            ))
+            .display(),
     );
     std::fs::write(&path, text)?;
     Ok(path)
