@@ -4,11 +4,12 @@
 //! What is measured: the daemon (`bearingd run`, a separate process, real time) runs
 //! `BENCH_SENSORS` simulated sensors at `BENCH_RATE` Hz whose outer races fail one after the
 //! other; this process subscribes to the alert service and, for each alert, takes its receipt
-//! time minus the alert's `wall_time_ns`: the moment the daemon's analysis took the block that
-//! completed the deciding window. Both clocks are the same machine's `CLOCK_REALTIME`.
-//! So the latency covers the analysis of that block (and of any block queued before it), the
-//! flag decision, the alert queue, iceoryx2 and the subscriber's wake-up; it does not cover
-//! the sensor's own block length (0.1 s of samples) or transport before the daemon.
+//! time minus the alert's `wall_time_ns`: the moment the daemon's source completed the block
+//! that completed the deciding window. Both clocks are the same machine's `CLOCK_REALTIME`.
+//! So the latency covers the wait in the analysis queue (behind other channels' blocks and
+//! band selections), the analysis of that block, the flag decision, the alert queue, iceoryx2
+//! and the subscriber's wake-up; it does not cover the sensor's own block length (0.1 s of
+//! samples) or the transport before the daemon.
 //!
 //! Run: `cargo bench --bench alert_latency` (about `BENCH_ROUNDS` × 75 s).
 
@@ -80,7 +81,7 @@ fn main() {
     }
     let sensors = env_or("BENCH_SENSORS", 16);
     let rate = env_or("BENCH_RATE", 25_600);
-    let rounds = env_or("BENCH_ROUNDS", 2);
+    let rounds = env_or("BENCH_ROUNDS", 4);
     let duration_s = 20.0 + 2.5 * sensors as f64 + 20.0;
     let mut latencies_ms = Vec::new();
     let mut lost = 0u64;

@@ -115,8 +115,9 @@ pub struct Alert {
     /// One past the last sample of the window that decided the change, in the channel's
     /// sample time (the same position the MCAP log's `/flags` message has).
     pub end_sample: u64,
-    /// When the daemon's analysis took the block that completed that window, ns since the Unix
-    /// epoch. Receipt time minus this is the alert's latency.
+    /// When the daemon's source completed the block that completed that window (assembled
+    /// it from CAN or iceoryx2 frames, or generated it for a simulated sensor), ns since the
+    /// Unix epoch. Receipt time minus this is the alert's latency.
     pub wall_time_ns: u64,
     pub sample_rate_hz: f64,
     /// The fault frequency the flag watches (BPFO, BPFI, 2BSF or FTF) at the current speed, Hz.

@@ -45,6 +45,11 @@ pub struct MonitorSettings {
     pub fs_hz: f64,
     pub analysis: AnalysisSettings,
     pub band_period_samples: u64,
+    /// Extra delay of the second band selection (the first is as soon as the history is
+    /// full), so that the channels of one daemon take turns instead of all selecting at the
+    /// same sample time: each selection holds the analysis thread for tens of ms, and a burst
+    /// over all channels delays every block (and alert) behind it. 0 for a lone channel.
+    pub band_phase_samples: u64,
     pub band_history_samples: usize,
     pub flags: FlagSettings,
     pub baseline_windows: u64,
@@ -176,6 +181,8 @@ pub struct ChannelMonitor {
     history_at: usize,
     history_filled: usize,
     next_band_selection: u64,
+    /// [`MonitorSettings::band_phase_samples`] until it has been added once.
+    band_phase_left: u64,
     next_sample: u64,
     scratch: Vec<f32>,
     clipping: bool,
@@ -247,6 +254,7 @@ impl ChannelMonitor {
             history_at: 0,
             history_filled: 0,
             next_band_selection: settings.band_history_samples.max(window) as u64,
+            band_phase_left: settings.band_phase_samples,
             next_sample: 0,
             scratch: vec![0.0; CHUNK],
             clipping: false,
@@ -414,8 +422,13 @@ impl ChannelMonitor {
                 if self.history_filled == self.history.len() {
                     self.select_bands(on_event);
                 }
+                let phase = if self.history_filled == self.history.len() {
+                    std::mem::take(&mut self.band_phase_left)
+                } else {
+                    0
+                };
                 self.next_band_selection =
-                    self.next_sample + self.settings.band_period_samples.max(1);
+                    self.next_sample + self.settings.band_period_samples.max(1) + phase;
             }
         }
     }

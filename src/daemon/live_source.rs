@@ -6,7 +6,7 @@
 //! buffer, where it is counted as an exact sequence gap.
 
 use super::messages::{ChannelId, IngestMessage};
-use super::pipeline::Input;
+use super::pipeline::{Arrived, Input};
 use crate::config::{Config, SensorConfig, Transport};
 use crate::ingest::{IngestEvent, IngestStats};
 use std::collections::BTreeMap;
@@ -114,7 +114,7 @@ pub async fn forward(
     mut events: tokio::sync::mpsc::Receiver<IngestEvent>,
     map: NodeMap,
     source: String,
-    inputs: tokio::sync::mpsc::Sender<Input>,
+    inputs: tokio::sync::mpsc::Sender<Arrived>,
 ) {
     let mut dropped_blocks = 0u64;
     while let Some(event) = events.recv().await {
@@ -132,7 +132,7 @@ pub async fn forward(
             other => map.to_input(other),
         };
         if let Some(input) = input {
-            if inputs.send(input).await.is_err() {
+            if inputs.send(Arrived::now(input)).await.is_err() {
                 return;
             }
         }

@@ -55,6 +55,25 @@ pub enum Input {
     Ingest(IngestMessage),
 }
 
+/// An input as it enters the analysis queue, with the wall-clock time (ns since the Unix
+/// epoch) at which its source completed it. The analysis never reads the time; `run` stamps it
+/// on the alerts the input causes, so that their latency counts the wait in the queue too.
+#[derive(Debug, Clone)]
+pub struct Arrived {
+    pub input: Input,
+    pub wall_ns: u64,
+}
+
+impl Arrived {
+    /// `input`, stamped now.
+    pub fn now(input: Input) -> Arrived {
+        Arrived {
+            input,
+            wall_ns: crate::mcap_log::wall_clock_now_ns(),
+        }
+    }
+}
+
 /// A request for the twin's re-fit, handed to the re-fit thread.
 #[derive(Debug, Clone)]
 pub struct TwinRequest {
@@ -117,7 +136,15 @@ pub struct Pipeline {
 }
 
 /// The monitor settings of one sensor: the config's durations turned into samples.
-pub fn monitor_settings(config: &Config, sensor: &SensorConfig) -> MonitorSettings {
+///
+/// `turn` of `turns` staggers the channel's band selections among the daemon's channels
+/// ([`MonitorSettings::band_phase_samples`]).
+pub fn monitor_settings(
+    config: &Config,
+    sensor: &SensorConfig,
+    turn: usize,
+    turns: usize,
+) -> MonitorSettings {
     let fs = sensor.sample_rate_hz;
     let t = &config.thresholds;
     let samples = |seconds: f64| (seconds * fs).round().max(0.0) as u64;
@@ -125,6 +152,7 @@ pub fn monitor_settings(config: &Config, sensor: &SensorConfig) -> MonitorSettin
         fs_hz: fs,
         analysis: config.analysis.clone(),
         band_period_samples: samples(config.band_period_s),
+        band_phase_samples: samples(config.band_period_s * turn as f64 / turns.max(1) as f64),
         band_history_samples: samples(band_history_s(config)) as usize,
         flags: FlagSettings {
             watch_score: t.watch_score,
@@ -193,6 +221,8 @@ impl Pipeline {
     /// One monitor per (sensor, axis); `baselines` resumes health stages kept across restarts.
     pub fn new(config: &Config, baselines: &BTreeMap<ChannelId, Baseline>) -> Self {
         let mut channels = BTreeMap::new();
+        let turns: usize = config.sensors.iter().map(|s| s.axes.len()).sum();
+        let mut turn = 0;
         for sensor in &config.sensors {
             // Without a starting speed the channel waits (nothing is scored); its frequencies
             // are then those at the highest speed, for sizing only.
@@ -207,10 +237,11 @@ impl Pipeline {
                     axis: axis.clone(),
                 };
                 let monitor = ChannelMonitor::new(
-                    monitor_settings(config, sensor),
+                    monitor_settings(config, sensor, turn, turns),
                     freqs,
                     baselines.get(&id).cloned(),
                 );
+                turn += 1;
                 let status = ChannelStatus {
                     channel: id.clone(),
                     rpm: monitor.shaft_hz().map(|hz| hz * 60.0),

@@ -8,8 +8,10 @@
 //! - analysis thread: the [`Pipeline`]; hands messages to the sink queue (`Block`), flag changes
 //!   as alerts to the alert queue (`DropNewest`, counted and reported; alerts are rare), and
 //!   twin requests to the re-fit queue (`DropNewest`: a request that finds the re-fit thread
-//!   busy is skipped and counted; the next period brings a fresh one). It stamps each input
-//!   with the wall clock when it takes it, for the alerts' latency; analysis never sees it.
+//!   busy is skipped and counted; the next period brings a fresh one). Each input carries the
+//!   wall-clock time its source completed it ([`Arrived`]); alerts carry that time of the
+//!   block that decided them, so their latency includes any wait in the queue. The analysis
+//!   never sees it.
 //! - alert thread: the iceoryx2 publisher of `outputs.alerts_service` ([`crate::alerts`]).
 //!   Alerts skip the sink queue so that MCAP compression never delays them.
 //! - re-fit thread: [`TwinWorker`]; its results go to the sink queue, and back to the analysis
@@ -22,7 +24,7 @@ use super::live_source::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
 use super::mcap_sink::McapSink;
 use super::messages::{FlagMessage, PipelineMessage, TwinMessage};
 use super::notify::{keep_alive, Notifier};
-use super::pipeline::{ChannelStatus, Input, Output, Pipeline, TwinRequest};
+use super::pipeline::{Arrived, ChannelStatus, Output, Pipeline, TwinRequest};
 use super::sim_source::SimSource;
 use super::twin_worker::TwinWorker;
 #[cfg(feature = "shm")]
@@ -148,7 +150,7 @@ pub async fn run(
     // an input changes no status (a SensorLost, a short block).
     let heartbeat = Arc::new(AtomicU64::new(0));
 
-    let (input_tx, mut input_rx) = tokio::sync::mpsc::channel::<Input>(ANALYSIS_QUEUE);
+    let (input_tx, mut input_rx) = tokio::sync::mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
     let (sink_tx, sink_rx) = mpsc::sync_channel::<PipelineMessage>(SINK_QUEUE);
     let (twin_tx, twin_rx) = mpsc::sync_channel::<TwinRequest>(1);
 
@@ -165,12 +167,12 @@ pub async fn run(
             .spawn(move || {
                 let mut pipeline = pipeline;
                 let mut alerts = alerts;
-                while let Some(input) = input_rx.blocking_recv() {
-                    let taken_ns = wall_clock_now_ns();
-                    pipeline.handle(input, &mut |output| match output {
+                while let Some(arrived) = input_rx.blocking_recv() {
+                    let arrived_ns = arrived.wall_ns;
+                    pipeline.handle(arrived.input, &mut |output| match output {
                         Output::Message(m) => {
                             if let Some((tracker, publisher)) = alerts.as_mut() {
-                                tracker.observe(&m, taken_ns, &mut |a| publisher.send(a));
+                                tracker.observe(&m, arrived_ns, &mut |a| publisher.send(a));
                             }
                             let _ = sink_tx.send(m);
                         }
@@ -419,10 +421,11 @@ fn start_alerts(_config: &Config) -> Result<Option<Alerts>, RunError> {
 /// Starts the SocketCAN and iceoryx2 sources of the config; `true` if there is any.
 fn start_live_sources(
     config: &Config,
-    inputs: &tokio::sync::mpsc::Sender<Input>,
+    inputs: &tokio::sync::mpsc::Sender<Arrived>,
     stop: &tokio::sync::watch::Receiver<bool>,
     tasks: &mut tokio::task::JoinSet<()>,
 ) -> Result<bool, RunError> {
+    #[cfg_attr(not(any(feature = "can", feature = "shm")), allow(unused_mut))]
     let mut any = false;
     // Each source's counters go to the log (`/ingest/<source>`) at the status interval.
     let status_interval = std::time::Duration::from_secs_f64(config.outputs.status_interval_s);
@@ -430,9 +433,9 @@ fn start_live_sources(
         let _ = stop.wait_for(|s| *s).await;
     };
     for (interface, map) in can_interfaces(config) {
-        any = true;
         #[cfg(feature = "can")]
         {
+            any = true;
             use crate::ingest::can;
             let source = can::open(can::CanSourceConfig {
                 interface: interface.clone(),
@@ -466,9 +469,9 @@ fn start_live_sources(
         }
     }
     for (sensor, map) in shm_sensors(config) {
-        any = true;
         #[cfg(feature = "shm")]
         {
+            any = true;
             use crate::ingest::{handoff::WhenFull, shm};
             let source = shm::ShmSourceConfig {
                 sensor: sensor.clone(),
@@ -507,7 +510,7 @@ fn start_live_sources(
 /// for the shutdown to go on (without it SIGTERM never stopped a run with a simulated sensor).
 async fn feed_simulated(
     mut sims: Vec<SimSource>,
-    tx: tokio::sync::mpsc::Sender<Input>,
+    tx: tokio::sync::mpsc::Sender<Arrived>,
     options: RunOptions,
     mut stop: tokio::sync::watch::Receiver<bool>,
 ) {
@@ -525,7 +528,7 @@ async fn feed_simulated(
         }
         for sim in sims.iter_mut() {
             for input in sim.next_blocks() {
-                if tx.send(input).await.is_err() {
+                if tx.send(Arrived::now(input)).await.is_err() {
                     return;
                 }
             }

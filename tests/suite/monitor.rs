@@ -15,6 +15,7 @@ fn settings(fs: f64) -> MonitorSettings {
         fs_hz: fs,
         analysis: AnalysisSettings::default(),
         band_period_samples: (20.0 * fs) as u64,
+        band_phase_samples: 0,
         band_history_samples: (10.0 * fs) as usize,
         flags: FlagSettings {
             watch_score: 10.0,
@@ -317,5 +318,58 @@ fn an_estimating_channel_finds_the_speed_before_it_scores() {
             .filter(|e| e.starts_with("flag"))
             .all(|e| e.starts_with("flag outer_race")),
         "{events:#?}"
+    );
+}
+
+/// The sample positions of a monitor's band selections.
+fn band_selections(
+    settings: MonitorSettings,
+    counts: &[i16],
+    params: &SimulationParams,
+) -> Vec<u64> {
+    let monitor = ChannelMonitor::new(settings, params.frequencies(), None);
+    let mut at = Vec::new();
+    let mut start = 0u64;
+    let mut monitor = monitor;
+    for chunk in counts.chunks(4096) {
+        monitor.push_counts(start, chunk, SCALE, &mut |e| {
+            if let MonitorEvent::Bands { at_sample, .. } = e {
+                at.push(at_sample);
+            }
+        });
+        start += chunk.len() as u64;
+    }
+    at
+}
+
+#[test]
+fn a_band_phase_staggers_the_selections_after_the_first() {
+    let (counts, params) = counts(75.0, 0.0);
+    let fs = params.fs_hz;
+    let plain = band_selections(settings(fs), &counts, &params);
+    let phase = (5.0 * fs) as u64;
+    let staggered = band_selections(
+        MonitorSettings {
+            band_phase_samples: phase,
+            ..settings(fs)
+        },
+        &counts,
+        &params,
+    );
+    let history = (10.0 * fs) as u64;
+    let period = (20.0 * fs) as u64;
+    // Both select as soon as the history is full, then every period; the staggered one's
+    // later selections sit `phase` later.
+    assert_eq!(
+        plain[..3],
+        [history, history + period, history + 2 * period]
+    );
+    assert_eq!(
+        staggered[..3],
+        [
+            history,
+            history + period + phase,
+            history + 2 * period + phase
+        ]
     );
 }
