@@ -73,9 +73,14 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         .build()
         .map_err(|e| CliError::failure(format!("cannot start the async runtime: {e}")))?;
     let sinks: Vec<Box<dyn Sink>> = vec![Box::new(FlagPrinter)];
-    let summary = runtime
-        .block_on(run(config, options, sinks, shutdown_signal()))
-        .map_err(CliError::input)?;
+    let summary = runtime.block_on(async {
+        let shutdown = shutdown_signal().map_err(|e| {
+            CliError::failure(format!("cannot install the SIGINT/SIGTERM handlers: {e}"))
+        })?;
+        run(config, options, sinks, shutdown)
+            .await
+            .map_err(CliError::input)
+    })?;
     println!(
         "summary: {} messages, {} twin fits ({} skipped while busy), {} alerts published{}",
         summary.messages,
@@ -113,23 +118,19 @@ fn embedded_default(args: &RunArgs) -> Result<Config, CliError> {
     Ok(config)
 }
 
-/// Resolves on SIGINT or SIGTERM (tokio owns the signals).
-async fn shutdown_signal() {
-    let ctrl_c = tokio::signal::ctrl_c();
-    #[cfg(unix)]
-    {
-        let mut term =
-            match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
-                Ok(term) => term,
-                Err(_) => return ctrl_c.await.unwrap_or(()),
-            };
+/// Installs the SIGINT and SIGTERM handlers now (tokio owns the signals) and returns a future
+/// that resolves on either. Installed before `run` starts, so a stop that comes right after
+/// READY is not taken by the default action (which would leave the MCAP file unfinished).
+fn shutdown_signal() -> std::io::Result<impl std::future::Future<Output = ()>> {
+    use tokio::signal::unix::{signal, SignalKind};
+    let mut interrupt = signal(SignalKind::interrupt())?;
+    let mut terminate = signal(SignalKind::terminate())?;
+    Ok(async move {
         tokio::select! {
-            _ = ctrl_c => {},
-            _ = term.recv() => {},
+            _ = interrupt.recv() => {},
+            _ = terminate.recv() => {},
         }
-    }
-    #[cfg(not(unix))]
-    let _ = ctrl_c.await;
+    })
 }
 
 /// The data directory of a run without a config: `--data-dir`, or `./bearingd-data`.
