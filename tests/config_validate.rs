@@ -669,3 +669,17 @@ fn transport_tables_are_checked_even_when_the_transport_is_wrong() {
         "{found:#?}"
     );
 }
+
+#[test]
+fn an_iceoryx2_root_too_long_for_its_sockets_is_refused() {
+    let long = format!("/srv/{}", "r".repeat(60));
+    let text = format!("{SENSOR}[outputs]\niceoryx2_root = \"{long}\"\n");
+    let problems = bearingd::config::parse(&text, "t.toml")
+        .unwrap_err()
+        .problems;
+    let problem = problems
+        .iter()
+        .find(|p| p.key == "outputs.iceoryx2_root")
+        .unwrap_or_else(|| panic!("{problems:?}"));
+    assert!(problem.message.contains("108 bytes"), "{}", problem.message);
+}

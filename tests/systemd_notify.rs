@@ -37,7 +37,7 @@ status_interval_s = 0.5
         // iceoryx2's root for the alert service: not under /tmp (the config refuses it).
         iox = Path::new(env!("CARGO_TARGET_TMPDIR"))
             .join(format!(
-                "iox-notify-{}",
+                "iox-sd-{}",
                 dir.file_name().unwrap_or_default().to_string_lossy()
             ))
             .display(),

@@ -138,20 +138,9 @@ fn data_dir(given: Option<&Path>) -> PathBuf {
     given.map_or_else(|| PathBuf::from("bearingd-data"), Path::to_path_buf)
 }
 
-/// The embedded default config with its files under the data directory: state, MCAP logs and
-/// the iceoryx2 root (so that a user without root can run it; `bearingd alerts --data-dir`
-/// finds the same root).
+/// The embedded default config for `--data-dir` (or `./bearingd-data`); see
+/// [`Config::embedded_in`].
 pub(super) fn embedded_config(data_dir_arg: Option<&Path>) -> Result<Config, CliError> {
-    let mut config = Config::default_embedded().map_err(CliError::failure)?;
     let data = data_dir(data_dir_arg);
-    let absolute = std::path::absolute(&data).map_err(|e| {
-        CliError::input(format!(
-            "{}: cannot make the data directory absolute: {e}; give --data-dir as an absolute path",
-            data.display()
-        ))
-    })?;
-    config.outputs.state_dir = data.join("state");
-    config.outputs.mcap_dir = data.join("mcap");
-    config.outputs.iceoryx2_root = absolute.join("iceoryx2");
-    Ok(config)
+    Config::embedded_in(&data).map_err(CliError::input)
 }

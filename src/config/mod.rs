@@ -59,7 +59,7 @@ pub use types::{
     CanConfig, Config, OutputConfig, SensorConfig, ShmConfig, SimConfig, SimFault, Speed,
     ThresholdConfig, Transport, TwinConfig,
 };
-pub use validate::MAX_ID_LEN;
+pub use validate::{MAX_ID_LEN, MAX_IOX_ROOT_LEN};
 
 /// The embedded default configuration: one simulated sensor on an SKF 6205-2RS at 1772 rpm,
 /// sampled at 25.6 kHz, whose outer race develops a fault after 30 s. Also the documented
@@ -129,4 +129,37 @@ impl Config {
     pub fn default_embedded() -> Result<Config, ConfigError> {
         parse(DEFAULT_TOML, EMBEDDED_ORIGIN)
     }
+
+    /// The embedded default with its state and MCAP logs under `data_dir`, and an iceoryx2
+    /// root of its own, so that a user without root can run it and `bearingd alerts
+    /// --data-dir` finds the same root.
+    ///
+    /// The root is `/tmp/bearingd-iox-<hash of the absolute data directory>` rather than
+    /// inside the data directory: iceoryx2's socket paths below the root must fit in 108
+    /// bytes, which a deep working directory would exceed ([`MAX_IOX_ROOT_LEN`]). /tmp is fine
+    /// here: this is not the systemd service, whose config keeps it out of a private /tmp.
+    pub fn embedded_in(data_dir: &Path) -> Result<Config, String> {
+        let mut config = Config::default_embedded().map_err(|e| e.to_string())?;
+        let absolute = std::path::absolute(data_dir).map_err(|e| {
+            format!(
+                "{}: cannot make the data directory absolute: {e}; give it as an absolute path",
+                data_dir.display()
+            )
+        })?;
+        config.outputs.state_dir = data_dir.join("state");
+        config.outputs.mcap_dir = data_dir.join("mcap");
+        config.outputs.iceoryx2_root = std::path::PathBuf::from(format!(
+            "/tmp/bearingd-iox-{:016x}",
+            fnv1a(absolute.as_os_str().as_encoded_bytes())
+        ));
+        Ok(config)
+    }
+}
+
+/// FNV-1a, 64 bits: a short name that is the same for the same input in every run and every
+/// build (std's hasher makes no such promise).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |hash, &b| {
+        (hash ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
 }

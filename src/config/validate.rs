@@ -23,6 +23,11 @@ use super::types::{
 
 /// Longest sensor id, in characters.
 pub const MAX_ID_LEN: usize = 32;
+/// Longest iceoryx2 root we accept, in bytes. iceoryx2 0.10 puts a subscriber's event
+/// socket about 44 bytes plus its file prefix below the root, and a Unix socket path has at
+/// most 108 bytes: roots of 64 bytes worked and 69 failed (measured); this leaves room for a
+/// test's longer file prefix.
+pub const MAX_IOX_ROOT_LEN: usize = 56;
 /// Longest iceoryx2 service name we accept, in bytes.
 const MAX_SERVICE_LEN: usize = 255;
 /// The kernel's IFNAMSIZ (16) less the terminating NUL.
@@ -1515,6 +1520,19 @@ impl Checker {
                     "{:?} is under {tmp}: systemd's PrivateTmp= gives the service its own \
                      {tmp}, which would hide iceoryx2's files from subscribers in other \
                      processes; {fix}",
+                    path.display().to_string()
+                ),
+            );
+            return None;
+        }
+        let length = path.as_os_str().len();
+        if length > MAX_IOX_ROOT_LEN {
+            self.problem(
+                key,
+                format!(
+                    "{:?} is {length} bytes long, more than {MAX_IOX_ROOT_LEN}: iceoryx2 puts \
+                     Unix sockets below it whose paths must fit in 108 bytes (a subscriber \
+                     could not wait for alerts); {fix}",
                     path.display().to_string()
                 ),
             );

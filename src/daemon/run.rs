@@ -386,8 +386,13 @@ fn start_alerts(config: &Config) -> Result<Option<Alerts>, RunError> {
             root_path: Some(config.outputs.iceoryx2_root.display().to_string()),
         },
     };
-    let publisher =
-        AlertPublisher::start(settings, history).map_err(|e| RunError::Alerts(e.to_string()))?;
+    let publisher = AlertPublisher::start(settings.clone(), history)
+        .map_err(|e| RunError::Alerts(e.to_string()))?;
+    eprintln!(
+        "bearingd: alerts on iceoryx2 service {} (root {})",
+        settings.service,
+        config.outputs.iceoryx2_root.display()
+    );
     let rates = config
         .sensors
         .iter()

@@ -34,10 +34,16 @@ fn a_python_subscriber_receives_the_raised_alert_of_a_simulated_fault() {
     let dir = scratch_dir("alerts-python");
     let data = dir.join("data");
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/alerts_subscriber.py");
+    let root = bearingd::config::Config::embedded_in(&data)
+        .unwrap()
+        .outputs
+        .iceoryx2_root
+        .display()
+        .to_string();
     // The subscriber first: it waits for the daemon to create the service.
     let subscriber = Command::new(python)
         .arg(script)
-        .args(["--root", data.join("iceoryx2").to_str().unwrap()])
+        .args(["--root", &root])
         .args(["--count", "1", "--timeout", "180"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -90,11 +96,8 @@ fn a_python_subscriber_receives_the_raised_alert_of_a_simulated_fault() {
 /// A config with one simulated sensor whose outer race is faulty from the start, files in
 /// `dir`, the iceoryx2 root under the target dir (the config refuses /tmp).
 fn fault_from_start_config(dir: &Path) -> PathBuf {
-    let iox = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
-        "iox-alerts-{}-{}",
-        std::process::id(),
-        dir.file_name().unwrap().to_string_lossy()
-    ));
+    // Short: iceoryx2's socket paths below it must fit in 108 bytes.
+    let iox = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ia-{}", std::process::id()));
     let text = format!(
         r#"
 [[sensors]]
