@@ -101,16 +101,21 @@ impl AlertTracker {
         }
     }
 
+    /// Called for every window of every channel: updates in place, so only a channel's
+    /// first window allocates (its key).
     fn note_scores(&mut self, m: &IndicatorsMessage) {
-        self.scores.insert(
-            m.channel.clone(),
-            [
-                m.score_outer_race,
-                m.score_inner_race,
-                m.score_ball,
-                m.score_cage,
-            ],
-        );
+        let scores = [
+            m.score_outer_race,
+            m.score_inner_race,
+            m.score_ball,
+            m.score_cage,
+        ];
+        match self.scores.get_mut(&m.channel) {
+            Some(slot) => *slot = scores,
+            None => {
+                self.scores.insert(m.channel.clone(), scores);
+            }
+        }
     }
 
     /// Takes a twin fit (also called by `run` for fits made on the re-fit thread).

@@ -7,6 +7,7 @@
 
 use super::run::embedded_config;
 use super::CliError;
+use crate::alerts::payload::AlertDecodeError;
 use crate::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
 use crate::alerts::{Alert, AlertState};
 use crate::config;
@@ -75,9 +76,12 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
     for received in subscriber.take_history(HISTORY_WAIT) {
         match received {
             Received::Alert(alert) => {
-                let Ok(view) = alert.view() else {
-                    printer.problem(&alert);
-                    continue;
+                let view = match alert.view() {
+                    Ok(view) => view,
+                    Err(e) => {
+                        printer.problem(&alert, &e);
+                        continue;
+                    }
                 };
                 let key = (view.sensor, view.axis, alert.fault);
                 if view.state == AlertState::Cleared {
@@ -220,9 +224,9 @@ impl Printer {
     }
 
     fn alert(&mut self, alert: &Alert, active_at_start: bool) {
-        let Ok(view) = alert.view() else {
-            self.problem(alert);
-            return;
+        let view = match alert.view() {
+            Ok(view) => view,
+            Err(e) => return self.problem(alert, &e),
         };
         self.printed += 1;
         if self.json {
@@ -239,13 +243,11 @@ impl Printer {
         }
     }
 
-    fn problem(&self, alert: &Alert) {
-        if let Err(e) = alert.view() {
-            eprintln!(
-                "bearingd alerts: cannot read alert #{}: {e}",
-                alert.sequence
-            );
-        }
+    fn problem(&self, alert: &Alert, error: &AlertDecodeError) {
+        eprintln!(
+            "bearingd alerts: cannot read alert #{}: {error}",
+            alert.sequence
+        );
     }
 
     fn event(&self, event: &Received) {

@@ -6,7 +6,7 @@
 //! buffer, where it is counted as an exact sequence gap.
 
 use super::messages::{ChannelId, IngestMessage};
-use super::pipeline::{Arrived, Input};
+use super::pipeline::Input;
 use crate::config::{Config, SensorConfig, Transport};
 use crate::ingest::{IngestEvent, IngestStats};
 use std::collections::BTreeMap;
@@ -105,6 +105,25 @@ pub fn shm_sensors(config: &Config) -> Vec<(String, NodeMap)> {
             _ => None,
         })
         .collect()
+}
+
+/// An input as it enters the analysis queue, with the wall-clock time (ns since the Unix
+/// epoch) at which its source completed it. The analysis never reads the time; `run` stamps it
+/// on the alerts the input causes, so that their latency counts the wait in the queue too.
+#[derive(Debug, Clone)]
+pub struct Arrived {
+    pub input: Input,
+    pub wall_ns: u64,
+}
+
+impl Arrived {
+    /// `input`, stamped now (the one wall-clock reading on the way in).
+    pub fn now(input: Input) -> Arrived {
+        Arrived {
+            input,
+            wall_ns: crate::mcap_log::wall_clock_now_ns(),
+        }
+    }
 }
 
 /// Forwards a source's events to the analysis queue until either side ends. Sample blocks of

@@ -55,25 +55,6 @@ pub enum Input {
     Ingest(IngestMessage),
 }
 
-/// An input as it enters the analysis queue, with the wall-clock time (ns since the Unix
-/// epoch) at which its source completed it. The analysis never reads the time; `run` stamps it
-/// on the alerts the input causes, so that their latency counts the wait in the queue too.
-#[derive(Debug, Clone)]
-pub struct Arrived {
-    pub input: Input,
-    pub wall_ns: u64,
-}
-
-impl Arrived {
-    /// `input`, stamped now.
-    pub fn now(input: Input) -> Arrived {
-        Arrived {
-            input,
-            wall_ns: crate::mcap_log::wall_clock_now_ns(),
-        }
-    }
-}
-
 /// A request for the twin's re-fit, handed to the re-fit thread.
 #[derive(Debug, Clone)]
 pub struct TwinRequest {

@@ -20,11 +20,11 @@
 //! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
 //!   them at shutdown happens there.
 
-use super::live_source::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
+use super::live_source::{can_interfaces, forward, shm_sensors, Arrived, SENSOR_TIMEOUT};
 use super::mcap_sink::McapSink;
-use super::messages::{FlagMessage, PipelineMessage, TwinMessage};
+use super::messages::{ChannelId, FlagMessage, PipelineMessage, TwinMessage};
 use super::notify::{keep_alive, Notifier};
-use super::pipeline::{Arrived, ChannelStatus, Output, Pipeline, TwinRequest};
+use super::pipeline::{ChannelStatus, Output, Pipeline, TwinRequest};
 use super::sim_source::SimSource;
 use super::twin_worker::TwinWorker;
 #[cfg(feature = "shm")]
@@ -32,7 +32,6 @@ use crate::alerts::tracker::history_size_for;
 use crate::alerts::tracker::AlertTracker;
 use crate::analysis::health::Baseline;
 use crate::config::{Config, Transport};
-use crate::daemon::messages::ChannelId;
 use crate::mcap_log::{wall_clock_now_ns, LoggerConfig};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
