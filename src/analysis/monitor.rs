@@ -10,10 +10,11 @@
 //!   and the rolling envelope follows one band per fault kind. Until the first selection the
 //!   channel is learning and raises no flag.
 //! - Scores, flags: each fault's score comes from its own band's averaged envelope spectrum;
-//!   the fault that dominates (its score at least `min_score_ratio` times every other, the
-//!   verdict's rule) drives its flag, the others' flags see 0. (choice) A second fault at the
-//!   same time shows once it dominates: this keeps one strong fault's leakage into the other
-//!   fault bands from raising false alarms.
+//!   the others are re-scored with the strongest explained away, and the verdict's rule
+//!   ([`Contest::lead`]: significant against noise, separable from every other detected
+//!   hypothesis) picks the fault whose score drives its flag; the others' flags see 0.
+//!   (choice) A second fault at the same time shows once it leads: this keeps one strong
+//!   fault's leakage into the other fault bands from raising false alarms.
 //! - Health: the stage tracker, fed with each window's kurtosis and RMS.
 //! - Sensor: clipping (counts at full scale) and a flat line (no change for a second) are
 //!   reported when they start and when they end.
@@ -28,6 +29,7 @@
 //!
 //! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
 
+use super::diagnosis::Contest;
 use super::envelope::FftPlans;
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultKind, FaultScore, FaultScorer};
@@ -171,6 +173,8 @@ pub struct ChannelMonitor {
     flags: [FaultFlag; 4],
     health: HealthTracker,
     scores: [FaultScore; 4],
+    /// The others' scores with the leader explained away (the leader's own entry unused).
+    explained: [FaultScore; 4],
     bands: [Band; 4],
     bands_known: bool,
     /// The last `band_history_samples` samples, for band re-selection, kept as the sensor's
@@ -190,16 +194,6 @@ pub struct ChannelMonitor {
     flat: bool,
     flat_since: u64,
     last_count: Option<i32>,
-}
-
-/// The fault whose score is at least `ratio` times every other fault's, if any.
-fn dominant_fault(scores: &[FaultScore; 4], ratio: f64) -> Option<usize> {
-    let top = (0..4).max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))?;
-    let runner_up = (0..4)
-        .filter(|&i| i != top)
-        .map(|i| scores[i].score)
-        .fold(0.0, f64::max);
-    (scores[top].score >= ratio * runner_up).then_some(top)
 }
 
 /// Samples converted per chunk (the scratch buffer's size).
@@ -247,6 +241,7 @@ impl ChannelMonitor {
             flags: std::array::from_fn(|_| FaultFlag::new(settings.flags)),
             health: HealthTracker::new(settings.baseline_windows, settings.sigma, 3, baseline),
             scores,
+            explained: scores,
             bands: [whole; 4],
             bands_known: false,
             history: vec![0; settings.band_history_samples.max(window)],
@@ -445,13 +440,14 @@ impl ChannelMonitor {
         self.history_filled = (self.history_filled + samples.len()).min(n);
         self.next_sample += samples.len() as u64;
 
-        let min_score_ratio = self.settings.analysis.min_score_ratio;
+        let rule = self.settings.analysis.decision_rule();
         let ChannelMonitor {
             rolling,
             scorer,
             flags,
             health,
             scores,
+            explained,
             bands,
             bands_known,
             freqs,
@@ -478,11 +474,31 @@ impl ChannelMonitor {
                 on_event(MonitorEvent::Stage(change));
             }
             if *bands_known && speed_known {
-                // Only the dominating fault feeds its flag (the verdict's rule: its score at least
-                // `min_score_ratio` times every other); the others see 0 and fall.
-                let dominant = dominant_fault(scores, min_score_ratio);
+                // Only the leading fault feeds its flag (the verdict's rule); the others see 0
+                // and fall.
+                let leader = (0..4)
+                    .max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))
+                    .unwrap_or(0);
                 for (i, kind) in FaultKind::ALL.iter().enumerate() {
-                    let score = if dominant == Some(i) {
+                    explained[i] = if i == leader {
+                        FaultScore::unscored(*kind, freqs)
+                    } else {
+                        let spectrum = update
+                            .bands
+                            .get(i)
+                            .map_or(&[][..], |b| b.averaged_amplitude());
+                        scorer.score_explained(
+                            spectrum,
+                            update.bin_hz,
+                            *kind,
+                            freqs,
+                            &scores[leader],
+                        )
+                    };
+                }
+                let lead = Contest::new(&scores[..], &explained[..]).and_then(|c| c.lead(&rule));
+                for (i, kind) in FaultKind::ALL.iter().enumerate() {
+                    let score = if lead == Some(*kind) {
                         scores[i].score
                     } else {
                         0.0

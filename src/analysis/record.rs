@@ -1,8 +1,13 @@
 //! Whole-record analysis, as `bearingd analyze` runs it: indicators, the band scan, band
-//! selection, per-hypothesis band refinement, fault scores and the verdict.
+//! selection, per-hypothesis band choice, fault scores and the verdict.
+//!
+//! (choice) Each hypothesis is scored in every candidate band wide enough to hold its comb
+//! (the full band always among them) and keeps the band where it shows best; its
+//! significance then pays for that choice (`−log10` of the number of bands tried, a Bonferroni
+//! bound). Band selection can thereby only add evidence, never cut it away.
 
 use super::band::Band;
-use super::diagnosis::{diagnose, Diagnosis};
+use super::diagnosis::{diagnose, Contest, Diagnosis};
 use super::envelope::{window_samples, EnvelopeSpectrum, FftPlans};
 use super::fault_bands::{FaultKind, FaultScore, FaultScorer};
 use super::indicators::Indicators;
@@ -86,8 +91,18 @@ impl RecordAnalysis {
 /// The highest envelope frequency the scores need: the last harmonic of the highest fault
 /// frequency, its upper sideband, and the noise neighbourhood beyond it.
 pub fn envelope_range_hz(freqs: &FaultFrequencies, harmonics: usize) -> f64 {
-    let top = freqs.bpfo.max(freqs.bpfi).max(freqs.two_bsf);
-    (harmonics as f64 + 0.5) * top + freqs.shaft
+    comb_width_hz(freqs, harmonics) + 0.5 * top_fault_hz(freqs)
+}
+
+/// The highest fault frequency with a comb worth scoring.
+fn top_fault_hz(freqs: &FaultFrequencies) -> f64 {
+    freqs.bpfo.max(freqs.bpfi).max(freqs.two_bsf)
+}
+
+/// The envelope bandwidth the combs need: the highest fault frequency's last harmonic and its
+/// upper sideband. A demodulation band narrower than this cannot hold them.
+pub fn comb_width_hz(freqs: &FaultFrequencies, harmonics: usize) -> f64 {
+    harmonics as f64 * top_fault_hz(freqs) + freqs.shaft.max(freqs.ftf)
 }
 
 /// Analyses whole records; keeps FFT plans between records so that only the first pays for
@@ -172,10 +187,12 @@ pub fn analyze_with_plans(
                     bands: vec![Band::new(lo_hz, hi_hz)],
                 }]
             }
-            _ => {
-                let top = freqs.bpfo.max(freqs.bpfi).max(freqs.two_bsf);
-                band_tree(fs_hz, settings.min_band_hz.unwrap_or(3.0 * top))
-            }
+            _ => band_tree(
+                fs_hz,
+                settings
+                    .min_band_hz
+                    .unwrap_or_else(|| comb_width_hz(freqs, settings.harmonics)),
+            ),
         };
         let with_gini = matches!(settings.band_selection, BandSelection::GiniKurtosis);
         let scan = scan_bands(
@@ -196,34 +213,49 @@ pub fn analyze_with_plans(
 
         let mut scorer =
             FaultScorer::new(settings.fault_tolerance, settings.harmonics, spectrum_bins);
-        let refine = settings.refine_band_by_snr
-            && !matches!(settings.band_selection, BandSelection::Fixed { .. });
+        let candidates = candidate_bands(&scan, selected_band_index, settings, freqs);
+        let penalty = (candidates.len().max(1) as f64).log10();
+        let best_band = |scorer: &mut FaultScorer, kind: FaultKind, winner: Option<&FaultScore>| {
+            candidates
+                .iter()
+                .map(|&i| {
+                    let spectrum = &scan.bands[i].spectrum;
+                    let mut score = match winner {
+                        None => scorer.score(&spectrum.amplitude, spectrum.bin_hz, kind, freqs),
+                        Some(w) => scorer.score_explained(
+                            &spectrum.amplitude,
+                            spectrum.bin_hz,
+                            kind,
+                            freqs,
+                            w,
+                        ),
+                    };
+                    score.significance = (score.significance - penalty).max(0.0);
+                    Hypothesis {
+                        score,
+                        band_index: i,
+                    }
+                })
+                .max_by(|a, b| a.score.score.total_cmp(&b.score.score))
+                .unwrap_or(Hypothesis {
+                    score: FaultScore::unscored(kind, freqs),
+                    band_index: selected_band_index,
+                })
+        };
         let hypotheses: Vec<Hypothesis> = FaultKind::ALL
             .iter()
-            .map(|&kind| {
-                let candidates: Vec<usize> = if refine {
-                    (0..scan.bands.len()).collect()
-                } else {
-                    vec![selected_band_index]
-                };
-                candidates
-                    .into_iter()
-                    .map(|i| {
-                        let spectrum = &scan.bands[i].spectrum;
-                        Hypothesis {
-                            score: scorer.score(&spectrum.amplitude, spectrum.bin_hz, kind, freqs),
-                            band_index: i,
-                        }
-                    })
-                    .max_by(|a, b| a.score.score.total_cmp(&b.score.score))
-                    .unwrap_or(Hypothesis {
-                        score: scorer.score(&[], bin_hz, kind, freqs),
-                        band_index: selected_band_index,
-                    })
-            })
+            .map(|&kind| best_band(&mut scorer, kind, None))
             .collect();
         let scores: Vec<FaultScore> = hypotheses.iter().map(|h| h.score).collect();
-        let diagnosis = diagnose(&scores, settings.min_fault_score, settings.min_score_ratio);
+        let explained: Vec<FaultScore> = match Contest::new(&scores, &[]) {
+            Some(contest) => FaultKind::ALL
+                .iter()
+                .filter(|&&kind| kind != contest.leader.fault)
+                .map(|&kind| best_band(&mut scorer, kind, Some(contest.leader)).score)
+                .collect(),
+            None => Vec::new(),
+        };
+        let diagnosis = diagnose(&scores, &explained, &settings.decision_rule());
         let reported_band_index = diagnosis
             .verdict
             .fault()
@@ -243,6 +275,33 @@ pub fn analyze_with_plans(
             reported_band_index,
         })
     }
+}
+
+/// The bands a hypothesis may be scored in: the full band, the selected band and, with
+/// refinement, every band of the scan at least as wide as the combs need.
+fn candidate_bands(
+    scan: &BandScan,
+    selected: usize,
+    settings: &AnalysisSettings,
+    freqs: &FaultFrequencies,
+) -> Vec<usize> {
+    if matches!(settings.band_selection, BandSelection::Fixed { .. }) {
+        return vec![selected];
+    }
+    let need = comb_width_hz(freqs, settings.harmonics);
+    let widest = (0..scan.bands.len()).max_by(|&a, &b| {
+        scan.bands[a]
+            .band
+            .width_hz()
+            .total_cmp(&scan.bands[b].band.width_hz())
+    });
+    (0..scan.bands.len())
+        .filter(|&i| {
+            i == selected
+                || Some(i) == widest
+                || (settings.refine_band_by_snr && scan.bands[i].band.width_hz() >= need)
+        })
+        .collect()
 }
 
 /// Windows a record should hold at least for a stable Welch average.

@@ -29,17 +29,33 @@ pub struct AnalysisSettings {
     /// Where a fault hypothesis exists, pick per hypothesis the candidate band whose envelope
     /// spectrum shows that fault's harmonics best (fault-band signal-to-noise ratio).
     pub refine_band_by_snr: bool,
-    /// Narrowest band the kurtogram may choose, in Hz. `None`: three times the highest fault
-    /// frequency, so that a band always holds the fault's sidebands.
+    /// Narrowest band the kurtogram may choose, in Hz. `None`: what the comb needs, the
+    /// highest fault frequency's last harmonic and its upper sideband (a narrower band cuts
+    /// the evidence away before it is scored).
     pub min_band_hz: Option<f64>,
     /// Relative search tolerance around each fault frequency (slip), e.g. 0.02 = ±2 %.
     pub fault_tolerance: f64,
     /// Harmonics of each fault frequency that count in its score.
     pub harmonics: usize,
-    /// A diagnosis needs the best fault score to reach this value...
+    /// A fault is named only if noise alone would give its comb with at most this
+    /// probability (per hypothesis and decision: per record, or per window in the daemon)...
+    pub false_alarm_rate: f64,
+    /// ...its score (geometric-mean peak-to-floor ratio over the comb) reaches this value...
     pub min_fault_score: f64,
-    /// ...and to exceed the runner-up by this factor; otherwise the diagnosis is `none`.
+    /// ...and it is this many times stronger than any other detected hypothesis once it is
+    /// explained away; otherwise the diagnosis is `none` (with both named).
     pub min_score_ratio: f64,
+}
+
+impl AnalysisSettings {
+    /// The decision rule these settings give.
+    pub fn decision_rule(&self) -> super::diagnosis::DecisionRule {
+        super::diagnosis::DecisionRule {
+            false_alarm_rate: self.false_alarm_rate,
+            min_fault_score: self.min_fault_score,
+            min_score_ratio: self.min_score_ratio,
+        }
+    }
 }
 
 impl Default for AnalysisSettings {
@@ -52,9 +68,10 @@ impl Default for AnalysisSettings {
             refine_band_by_snr: true,
             min_band_hz: None,
             fault_tolerance: 0.02,
-            harmonics: 3,
-            min_fault_score: 15.0,
-            min_score_ratio: 2.0,
+            harmonics: 5,
+            false_alarm_rate: 1e-3,
+            min_fault_score: 5.0,
+            min_score_ratio: 1.5,
         }
     }
 }

@@ -127,6 +127,7 @@ pub(crate) struct RawAnalysis {
     pub min_band_hz: Field<f64>,
     pub fault_tolerance: Field<f64>,
     pub harmonics: Field<i64>,
+    pub false_alarm_rate: Field<f64>,
     pub min_fault_score: Field<f64>,
     pub min_score_ratio: Field<f64>,
 }

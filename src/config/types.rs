@@ -222,8 +222,8 @@ pub struct ThresholdConfig {
 impl Default for ThresholdConfig {
     fn default() -> Self {
         ThresholdConfig {
-            watch_score: 10.0,
-            alarm_score: 15.0,
+            watch_score: 5.0,
+            alarm_score: 10.0,
             clear_ratio: 0.8,
             on_delay_s: 5.0,
             off_delay_s: 30.0,

@@ -1048,18 +1048,27 @@ impl Checker {
             .integer(
                 "analysis.harmonics",
                 &raw.harmonics,
-                i64::try_from(d.harmonics).unwrap_or(3),
+                i64::try_from(d.harmonics).unwrap_or(5),
                 1,
                 10,
-                "give how many harmonics of each fault frequency count, e.g. harmonics = 3",
+                "give how many harmonics of each fault frequency count, e.g. harmonics = 5",
             )
             .and_then(|n| usize::try_from(n).ok());
+        let false_alarm_rate = self.number(
+            "analysis.false_alarm_rate",
+            &raw.false_alarm_rate,
+            d.false_alarm_rate,
+            Limits::above_to(0.0, 0.5),
+            "give the probability noise alone may name a fault per decision, e.g. \
+             false_alarm_rate = 0.001",
+        );
         let min_fault_score = self.number(
             "analysis.min_fault_score",
             &raw.min_fault_score,
             d.min_fault_score,
-            Limits::above_to(0.0, f64::INFINITY),
-            "give the smallest fault score that makes a diagnosis, e.g. min_fault_score = 15.0",
+            Limits::within(1.0, f64::INFINITY),
+            "give the smallest comb score (peak-to-floor ratio, at least 1) that makes a \
+             diagnosis, e.g. min_fault_score = 5.0",
         );
         let min_score_ratio = self.number(
             "analysis.min_score_ratio",
@@ -1067,7 +1076,7 @@ impl Checker {
             d.min_score_ratio,
             Limits::within(1.0, f64::INFINITY),
             "give how many times the best fault score must exceed the runner-up, at least 1, \
-             e.g. min_score_ratio = 2.0",
+             e.g. min_score_ratio = 1.5",
         );
         Some((
             AnalysisSettings {
@@ -1079,6 +1088,7 @@ impl Checker {
                 min_band_hz: min_band_hz?,
                 fault_tolerance: fault_tolerance?,
                 harmonics: harmonics?,
+                false_alarm_rate: false_alarm_rate?,
                 min_fault_score: min_fault_score?,
                 min_score_ratio: min_score_ratio?,
             },
@@ -1270,10 +1280,10 @@ impl Checker {
             &raw.watch_score,
             d.watch_score,
             Limits::above_to(0.0, f64::INFINITY),
-            "give the fault score at which a flag rises to watch, e.g. watch_score = 15.0",
+            "give the fault score at which a flag rises to watch, e.g. watch_score = 5.0",
         );
         let alarm_fix = "give the fault score at which a flag rises to alarm, above \
-                         watch_score, e.g. alarm_score = 15.0";
+                         watch_score, e.g. alarm_score = 10.0";
         let alarm_score = self.number(
             "thresholds.alarm_score",
             &raw.alarm_score,

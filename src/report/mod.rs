@@ -75,7 +75,12 @@ pub struct HypothesisReport {
     pub fault: FaultKind,
     pub frequency_hz: f64,
     pub band_hz: [f64; 2],
+    /// Geometric-mean peak-to-floor ratio over the comb.
     pub score: f64,
+    /// `−log10` of the probability noise alone gives this comb (after the band search).
+    pub significance: f64,
+    /// The comb's fitted slip, relative.
+    pub slip: f64,
     pub sideband_score: Option<f64>,
     pub harmonics: Vec<HarmonicPeak>,
 }
@@ -101,6 +106,8 @@ pub struct AnalyzeReport {
     pub diagnosis: &'static str,
     pub confidence: f64,
     pub reason: String,
+    /// With `none`: the faults that were each detected but could not be told apart.
+    pub candidates: Vec<FaultKind>,
     pub thresholds: Thresholds,
     pub indicators: Indicators,
     pub hypotheses: Vec<HypothesisReport>,
@@ -164,6 +171,7 @@ impl TwinReport {
 /// The decision thresholds the verdict was reached with.
 #[derive(Debug, Clone, Serialize)]
 pub struct Thresholds {
+    pub false_alarm_rate: f64,
     pub min_fault_score: f64,
     pub min_score_ratio: f64,
     pub fault_tolerance: f64,
@@ -236,7 +244,9 @@ impl AnalyzeReport {
             diagnosis: analysis.diagnosis.verdict.name(),
             confidence: analysis.diagnosis.confidence,
             reason: analysis.diagnosis.reason.clone(),
+            candidates: analysis.diagnosis.candidates.clone(),
             thresholds: Thresholds {
+                false_alarm_rate: settings.false_alarm_rate,
                 min_fault_score: settings.min_fault_score,
                 min_score_ratio: settings.min_score_ratio,
                 fault_tolerance: settings.fault_tolerance,
@@ -251,6 +261,8 @@ impl AnalyzeReport {
                     frequency_hz: h.score.frequency_hz,
                     band_hz: band_pair(analysis.scan.bands[h.band_index].band),
                     score: h.score.score,
+                    significance: h.score.significance,
+                    slip: h.score.slip,
                     sideband_score: h.score.sideband_score,
                     harmonics: h.score.peaks().to_vec(),
                 })

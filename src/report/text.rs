@@ -39,9 +39,10 @@ pub fn render_text(r: &AnalyzeReport) -> String {
     );
     let _ = writeln!(
         out,
-        "  fault scores (peak/median over {} harmonics, ±{:.0} %; a fault needs ≥ {:.0} and {:.1}× the runner-up):",
+        "  fault scores (comb peak/floor over {} harmonics and their sidebands, ±{:.0} % slip; a fault needs p ≤ {:.0e} against noise, ≥ {:.1}, and {:.1}× any other detected fault once explained):",
         r.thresholds.harmonics,
         r.thresholds.fault_tolerance * 100.0,
+        r.thresholds.false_alarm_rate,
         r.thresholds.min_fault_score,
         r.thresholds.min_score_ratio
     );
@@ -53,9 +54,10 @@ pub fn render_text(r: &AnalyzeReport) -> String {
             .unwrap_or_default();
         let _ = writeln!(
             out,
-            "    {:<11} {:>7.1}  {:<40} in {:.0}–{:.0} Hz{}",
+            "    {:<11} {:>7.1}  p=10^-{:<5.1} {:<40} in {:.0}–{:.0} Hz{}",
             h.fault.name(),
             h.score,
+            h.significance,
             "#".repeat(bar_len),
             h.band_hz[0],
             h.band_hz[1],

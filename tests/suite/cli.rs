@@ -220,7 +220,7 @@ fn validate_lists_every_problem_and_config_default_is_valid() {
     let text = committed
         .replace("sample_rate_hz = 25600", "sample_rate_hz = 0")
         .replace("overlap = 0.5", "overlap = 2.0")
-        .replace("harmonics = 3", "harmonics = 0");
+        .replace("harmonics = 5", "harmonics = 0");
     std::fs::write(&bad, text).unwrap();
     let out = bearingd(&["validate", bad.to_str().unwrap()]);
     let err = stderr(&out);
