@@ -30,6 +30,7 @@ pub mod config;
 pub mod daemon;
 pub mod ingest;
 pub mod mcap_log;
+pub mod messages;
 pub mod offline;
 pub mod plot;
 pub mod recording;

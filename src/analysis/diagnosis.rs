@@ -5,7 +5,8 @@
 //! `min_score_ratio`; otherwise the verdict is `none`. Close calls are reported as `none` with
 //! the reason, never as a guess.
 
-use super::fault_bands::{FaultKind, FaultScore};
+use super::fault_bands::FaultScore;
+use crate::messages::FaultKind;
 use serde::Serialize;
 
 /// What the analysis concludes.

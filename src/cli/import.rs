@@ -3,8 +3,8 @@
 //! (`bearingd replay DIR/*.mcap --config DIR/replay.toml`).
 
 use super::{CliError, RecordingArgs};
-use crate::daemon::messages::{ChannelId, PipelineMessage, RawBlock};
 use crate::mcap_log::{LoggerConfig, McapLogger};
+use crate::messages::{ChannelId, PipelineMessage, RawBlock};
 use crate::offline::{resolve_conditions, AnalyzeRequest};
 use crate::recording::read_recording;
 use clap::Args;

@@ -3,8 +3,8 @@
 
 use super::CliError;
 use crate::config::{self, Config};
-use crate::daemon::messages::PipelineMessage;
 use crate::daemon::run::{run, status_line, RunOptions, Sink};
+use crate::messages::{HealthKind, PipelineMessage};
 use clap::Args;
 use std::path::{Path, PathBuf};
 
@@ -37,12 +37,7 @@ impl Sink for FlagPrinter {
                 "FLAG {}: {} {} -> {} (score {:.1}, {:.1} Hz) at sample {}",
                 f.channel, f.fault, f.from, f.to, f.score, f.fault_frequency_hz, f.end_sample
             ),
-            PipelineMessage::Health(h)
-                if matches!(
-                    h.kind.as_str(),
-                    "stage" | "lost" | "back" | "gap" | "restart" | "saturation" | "flat_line"
-                ) =>
-            {
+            PipelineMessage::Health(h) if h.kind != HealthKind::Bands => {
                 println!(
                     "HEALTH {}: {} at sample {}",
                     h.channel, h.detail, h.end_sample

@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use crate::analysis::AnalysisSettings;
 use crate::bearing::BearingGeometry;
+use crate::messages::SpeedSource;
 
 /// A complete, validated configuration.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -166,12 +167,12 @@ impl Speed {
         }
     }
 
-    /// The name of the source, as in the config.
-    pub fn source_name(&self) -> &'static str {
+    /// Where the speed comes from (the config's `source`).
+    pub fn source(&self) -> SpeedSource {
         match self {
-            Speed::Fixed { .. } => "fixed",
-            Speed::Frames { .. } => "can",
-            Speed::Estimate { .. } => "estimate",
+            Speed::Fixed { .. } => SpeedSource::Fixed,
+            Speed::Frames { .. } => SpeedSource::Can,
+            Speed::Estimate { .. } => SpeedSource::Estimate,
         }
     }
 }

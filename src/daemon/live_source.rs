@@ -5,10 +5,10 @@
 //! waits when the analysis queue is full, which pushes the loss back into the transport's own
 //! buffer, where it is counted as an exact sequence gap.
 
-use super::messages::{ChannelId, IngestMessage};
 use super::pipeline::Input;
 use crate::config::{Config, SensorConfig, Transport};
 use crate::ingest::{IngestEvent, IngestStats};
+use crate::messages::{ChannelId, IngestMessage};
 use std::collections::BTreeMap;
 use std::time::Duration;
 

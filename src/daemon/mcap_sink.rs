@@ -2,9 +2,9 @@
 //! every second of data (a crash loses at most that), recovers unfinished files at start, and
 //! finishes the file at shutdown.
 
-use super::messages::PipelineMessage;
 use super::run::Sink;
 use crate::mcap_log::{recover_directory, LoggerConfig, McapLogError, McapLogger, RecoveryReport};
+use crate::messages::PipelineMessage;
 use std::collections::HashMap;
 use std::path::Path;
 

@@ -4,7 +4,6 @@
 //! - [`live_source`]: the SocketCAN and iceoryx2 sources mapped onto the config's channels.
 //! - [`mcap_sink`]: the MCAP log as a sink (time mapping, flushes, recovery at start).
 //! - [`replay`]: logged raw samples through the same pipeline.
-//! - [`messages`]: what flows to the sinks; the MCAP log's schema.
 //! - [`notify`]: the systemd notify protocol (READY, STATUS, WATCHDOG, STOPPING).
 //! - [`pipeline`]: the analysis stage shared by `run` and `replay` (sample time only).
 //! - [`run`]: threads, queues, shutdown and status of `bearingd run`.
@@ -13,7 +12,6 @@
 
 pub mod live_source;
 pub mod mcap_sink;
-pub mod messages;
 pub mod notify;
 pub mod pipeline;
 pub mod replay;

@@ -8,12 +8,12 @@
 //! The twin's re-fits run inline here (the live run does them on their own thread): they do
 //! not influence flags, so the flags of a replay equal the live run's at the same samples.
 
-use super::messages::{FlagMessage, PipelineMessage};
 use super::pipeline::{Input, Output, Pipeline};
 use super::run::Sink;
 use super::twin_worker::TwinWorker;
 use crate::config::Config;
 use crate::mcap_log::{read_messages, ReadSummary};
+use crate::messages::{FlagMessage, PipelineMessage};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};

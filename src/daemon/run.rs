@@ -22,7 +22,6 @@
 
 use super::live_source::{can_interfaces, forward, shm_sensors, Arrived, SENSOR_TIMEOUT};
 use super::mcap_sink::McapSink;
-use super::messages::{ChannelId, FlagMessage, PipelineMessage, TwinMessage};
 use super::notify::{keep_alive, Notifier};
 use super::pipeline::{ChannelStatus, Output, Pipeline, TwinRequest};
 use super::sim_source::SimSource;
@@ -33,6 +32,9 @@ use crate::alerts::tracker::AlertTracker;
 use crate::analysis::health::Baseline;
 use crate::config::{Config, Transport};
 use crate::mcap_log::{wall_clock_now_ns, LoggerConfig};
+use crate::messages::{
+    ChannelId, FaultKind, FlagLevel, FlagMessage, PipelineMessage, SpeedSource, TwinMessage,
+};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -186,7 +188,7 @@ pub async fn run(
                         .map(|mut f| std::mem::take(&mut *f))
                         .unwrap_or_default();
                     for fit in &fits {
-                        pipeline.note_twin(&fit.channel, &fit.hypothesis, fit.error);
+                        pipeline.note_twin(&fit.channel, fit.hypothesis, fit.error);
                         if let Some((tracker, _)) = alerts.as_mut() {
                             tracker.note_twin(fit);
                         }
@@ -585,16 +587,16 @@ pub fn status_line(s: &ChannelStatus) -> String {
         (Some(h), Some(e)) => format!("{h} err {e:.3}"),
         _ => "-".into(),
     };
-    let flags: Vec<String> = crate::analysis::FaultKind::ALL
+    let flags: Vec<String> = FaultKind::ALL
         .iter()
         .zip(&s.flags)
-        .filter(|(_, l)| l.name() != "ok")
-        .map(|(k, l)| format!("{}={}", k.name(), l.name()))
+        .filter(|(_, l)| **l != FlagLevel::Ok)
+        .map(|(k, l)| format!("{k}={l}"))
         .collect();
     let rpm = match (s.rpm, s.speed_source) {
-        (Some(rpm), "fixed") => format!("{rpm:.0}"),
+        (Some(rpm), SpeedSource::Fixed) => format!("{rpm:.0}"),
         (Some(rpm), source) => format!("{rpm:.0}({source})"),
-        (None, "estimate") => "?(no estimate yet: scoring waits)".to_string(),
+        (None, SpeedSource::Estimate) => "?(no estimate yet: scoring waits)".to_string(),
         (None, _) => "?(no usable speed frame: scoring waits)".to_string(),
     };
     format!(
@@ -621,11 +623,11 @@ fn systemd_status(board: &[ChannelStatus]) -> String {
     let channels: Vec<String> = board
         .iter()
         .map(|s| {
-            let flags: Vec<String> = crate::analysis::FaultKind::ALL
+            let flags: Vec<String> = FaultKind::ALL
                 .iter()
                 .zip(&s.flags)
-                .filter(|(_, l)| l.name() != "ok")
-                .map(|(k, l)| format!("{}={}", k.name(), l.name()))
+                .filter(|(_, l)| **l != FlagLevel::Ok)
+                .map(|(k, l)| format!("{k}={l}"))
                 .collect();
             let flags = if flags.is_empty() {
                 "ok".to_string()

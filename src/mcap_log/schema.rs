@@ -18,7 +18,7 @@ use prost_types::{
 };
 use serde_json::{json, Value};
 
-use crate::daemon::messages::{ChannelId, RawBlock};
+use crate::messages::{ChannelId, RawBlock};
 
 /// Schema name (fully qualified protobuf message name) of raw blocks.
 pub const RAW_BLOCK_SCHEMA: &str = "bearingd.RawBlock";

@@ -24,7 +24,7 @@ use mcap::{Compression, WriteOptions};
 
 use super::error::{io_err, McapLogError, Result};
 use super::schema::{self, JsonKind, RawBlockPb, RAW_BLOCK_SCHEMA};
-use crate::daemon::messages::PipelineMessage;
+use crate::messages::PipelineMessage;
 
 /// File name prefix of every log file; retention only ever touches `bearingd-*.mcap`.
 pub const FILE_PREFIX: &str = "bearingd-";

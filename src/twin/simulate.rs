@@ -9,8 +9,8 @@
 //! deterministic for a given seed.
 
 use super::rng::Rng;
-use crate::analysis::FaultKind;
 use crate::bearing::{BearingGeometry, FaultFrequencies};
+use crate::messages::FaultKind;
 use serde::Serialize;
 
 /// Which defect the simulated bearing has.
