@@ -27,6 +27,21 @@ pub struct Config {
     pub outputs: OutputConfig,
 }
 
+impl Config {
+    /// The sample rate of every sensor, by id.
+    pub fn sample_rates(&self) -> std::collections::HashMap<String, f64> {
+        self.sensors
+            .iter()
+            .map(|s| (s.id.clone(), s.sample_rate_hz))
+            .collect()
+    }
+
+    /// How many channels (sensor axes) the config analyses.
+    pub fn channel_count(&self) -> usize {
+        self.sensors.iter().map(|s| s.axes.len()).sum()
+    }
+}
+
 /// One accelerometer (`[[sensors]]`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SensorConfig {

@@ -4,7 +4,7 @@
 
 use bearingd::mcap_log::read_messages;
 use bearingd::messages::PipelineMessage;
-use bearingd::recording::testdata::{check_mcap_with_python, python_mcap, scratch_dir};
+use bearingd_testdata::{check_mcap_with_python, python_mcap, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -382,12 +382,12 @@ iceoryx2_root = "{iox}"
 /// and no other; no record raises a flag of a wrong fault.
 #[test]
 fn imported_cwru_records_replayed_raise_the_right_flags() {
-    let Some(data) = bearingd::recording::testdata::shared_data_dir("cwru") else {
+    let Some(data) = bearingd_testdata::shared_data_dir("cwru") else {
         return;
     };
     let dir = scratch_dir("daemon-import");
     let mut problems = Vec::new();
-    for row in bearingd::recording::testdata::read_manifest(&data) {
+    for row in bearingd_testdata::read_manifest(&data) {
         let out = dir.join(row["file"].replace(['@', '.'], "_"));
         let imported = bearingd(&[
             "import",

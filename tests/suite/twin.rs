@@ -5,9 +5,9 @@ use bearingd::analysis::envelope::FftPlans;
 use bearingd::analysis::Band;
 use bearingd::messages::FaultKind;
 use bearingd::offline::{analyze, AnalyzeRequest};
-use bearingd::recording::testdata::{read_manifest, shared_data_dir};
 use bearingd::twin::diagnose::fit_record;
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator, TwinFitter};
+use bearingd_testdata::{read_manifest, shared_data_dir};
 
 #[test]
 fn simulation_is_deterministic_and_blockwise_equals_one_shot() {

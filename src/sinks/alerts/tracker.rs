@@ -228,7 +228,7 @@ impl AlertTracker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::alerts::payload::AlertState;
+    use crate::sinks::alerts::payload::AlertState;
     use FaultKind::{Ball, InnerRace, OuterRace};
     use FlagLevel::{Alarm, Watch};
     const OK: FlagLevel = FlagLevel::Ok;

@@ -1,7 +1,7 @@
 //! The twin's periodic re-fit, on its own thread (FFT-heavy work never runs on the async
 //! side), warm-started per channel from the previous fit.
 
-use super::pipeline::TwinRequest;
+use super::TwinRequest;
 use crate::analysis::envelope::{window_samples, FftPlans};
 use crate::messages::{ChannelId, TwinMessage};
 use crate::twin::diagnose::fit_record;

@@ -1,10 +1,19 @@
-//! The analysis stage of the daemon, shared by `run` and `replay`: inputs in sample time
-//! (sample blocks and sensor events, whatever their source) → one [`ChannelMonitor`] per
-//! channel → messages for the sinks, and requests for the twin's re-fit.
+//! The per-channel pipeline, shared by `run` and `replay`: inputs in sample time (sample blocks
+//! and sensor events, whatever their source) → one [`ChannelMonitor`] per channel →
+//! [`Output`]s: messages for the sinks, and requests for the twin's re-fit ([`refit`]).
 //!
 //! Synchronous and single-threaded on purpose: it runs on its own thread in `run` and in
 //! `replay` alike, and its outputs depend only on its inputs, so a replay of the logged raw
 //! samples gives the same flags at the same samples.
+//!
+//! [`Sink`] is the seam to the sinks: the pipeline's messages go to whatever implements it
+//! (the MCAP log, the command line's flag printer), and the pipeline knows none of them.
+
+pub mod refit;
+mod sink;
+
+pub use refit::TwinWorker;
+pub use sink::{Sink, SinkError};
 
 use crate::analysis::flags::FlagSettings;
 use crate::analysis::health::Baseline;
@@ -75,7 +84,7 @@ pub enum Output {
     Twin(TwinRequest),
 }
 
-/// The latest state of a channel, for status lines and the exit summary.
+/// The latest state of a channel, for status lines, systemd's status and the exit summary.
 #[derive(Debug, Clone, Serialize)]
 pub struct ChannelStatus {
     pub channel: ChannelId,
@@ -95,6 +104,24 @@ pub struct ChannelStatus {
     pub twin_error: Option<f64>,
     pub sensor_lost: bool,
     pub flag_changes: u64,
+}
+
+impl ChannelStatus {
+    /// The raised flags as `fault=level` joined by commas (`outer_race=alarm,ball=watch`), or
+    /// `ok` when none is raised.
+    pub fn flags_summary(&self) -> String {
+        let raised: Vec<String> = FaultKind::ALL
+            .iter()
+            .zip(&self.flags)
+            .filter(|(_, level)| **level != FlagLevel::Ok)
+            .map(|(fault, level)| format!("{fault}={level}"))
+            .collect();
+        if raised.is_empty() {
+            "ok".to_string()
+        } else {
+            raised.join(",")
+        }
+    }
 }
 
 struct Channel {
