@@ -335,8 +335,10 @@ impl AnalysisThread {
                 let _ = sinks.send(message);
             }
             Output::Twin(request) => {
-                let sent = twin_requests.as_ref().map(|queue| queue.try_send(request));
-                if !matches!(sent, Some(Ok(()))) {
+                let sent = twin_requests
+                    .as_ref()
+                    .is_some_and(|queue| queue.try_send(request).is_ok());
+                if !sent {
                     *requests_skipped += 1;
                 }
             }
