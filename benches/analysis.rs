@@ -4,6 +4,7 @@
 //!
 //! Run: `cargo bench --bench analysis`. The record is CWRU 105 when ../shared/data is there,
 //! else 10 s of the twin's simulated outer-race fault (the same size).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::envelope::{FftPlans, RollingEnvelope};
 use bearingd::analysis::record::{analyze_record, RecordAnalyzer};

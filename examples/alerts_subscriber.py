@@ -2,7 +2,7 @@
 """Receive bearingd's fault alerts in Python, over iceoryx2 (the `iceoryx2` package on PyPI).
 
 A gateway, an HMI or a maintenance script can start from this. It mirrors the daemon's
-`#[repr(C)]` alert record (src/alerts/payload.rs, docs/ALERTS.md) as a ctypes structure whose
+`#[repr(C)]` alert record (src/sinks/alerts/payload.rs, docs/ALERTS.md) as a ctypes structure whose
 `type_name()` is the Rust type name, so iceoryx2 matches the two.
 
     pip install iceoryx2==0.10.0

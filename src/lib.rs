@@ -2,36 +2,52 @@
 //!
 //! # Layout
 //!
-//! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
-//!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
-//!   cannot disagree.
-//! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies.
-//! - [`config`]: the TOML configuration, parsed raw then validated into typed settings, with
-//!   every problem reported at once.
-//! - [`recording`]: readers for recorded data (CWRU `.mat`, PRONOSTIA and plain CSV, IMS text,
-//!   WAV) that turn a file into samples plus what the file says about itself.
+//! The rooms, top to bottom: a room uses only rooms listed below it, never one above
+//! (`scripts/module_deps.py` checks this in CI, and that there is no import cycle).
+//!
+//! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
+//! - [`daemon`]: wiring only: `run` and `replay` lock the data dir, start sources, the pipeline
+//!   and sinks, and stop them; what happens is reported as typed events, never printed.
+//! - [`sources`]: SocketCAN, iceoryx2, the simulated sensor and MCAP replay → sample blocks in
+//!   sample time, counting gaps, restarts, silent sensors and malformed frames.
+//! - [`sinks`]: where the pipeline's messages go: the MCAP log writer, iceoryx2 alerts, the
+//!   systemd notify protocol.
 //! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
 //! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
-//! - [`mcap_log`]: the MCAP log: chunked, compressed files with a decodable schema per topic,
-//!   rotation and a disk budget, crash recovery, and the reader that replay uses.
-//! - [`twin`]: the signal-model twin of a defective bearing (simulation now, fitting later).
-//! - [`ingest`]: sources (SocketCAN, iceoryx2) that turn sensor frames into sample blocks in
-//!   sample time, counting gaps, restarts, silent sensors and malformed frames.
-//! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
+//! - [`pipeline`]: the per-channel pipeline shared by `run` and `replay`, its outputs, the twin's
+//!   re-fit requests and the [`Sink`](pipeline::Sink) trait, the seam to the sinks.
+//! - [`config`]: the TOML configuration, parsed raw then validated into typed settings (one file
+//!   per section), with every problem reported at once.
+//! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the
+//!   `bearing-iox` crate, shared with the publishers).
+//! - [`twin`]: the signal-model twin of a defective bearing: simulation and online fits.
+//! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
+//!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
+//!   cannot disagree.
+//! - [`recording`]: readers for recorded data (CWRU `.mat`, PRONOSTIA and plain CSV, IMS text,
+//!   WAV) that turn a file into samples plus what the file says about itself.
+//! - [`mcap_log`]: the MCAP log's format: topics, schemas, file names, the bounded scanner and
+//!   the reader (the writer is a sink, the replay a source).
+//! - [`messages`]: the vocabulary every room above speaks: typed faults, flags, health stages,
+//!   speed sources and the pipeline's messages; MCAP and iceoryx2 encode them at the edge.
+//! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies.
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
 
-pub mod alerts;
 pub mod analysis;
 pub mod bearing;
 pub mod cli;
 pub mod config;
 pub mod daemon;
-pub mod ingest;
+pub mod iox;
 pub mod mcap_log;
+pub mod messages;
 pub mod offline;
+pub mod pipeline;
 pub mod plot;
 pub mod recording;
 pub mod report;
+pub mod sinks;
+pub mod sources;
 pub mod twin;

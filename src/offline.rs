@@ -7,9 +7,9 @@
 //! resolved is an error that says which option gives it.
 
 use crate::analysis::record::RecordAnalyzer;
-use crate::analysis::FaultKind;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
 use crate::bearing::{BearingError, BearingGeometry};
+use crate::messages::FaultKind;
 use crate::recording::{read_recording, ReadOptions, Recording, RecordingError, RecordingFormat};
 use crate::report::{AnalyzeReport, RecordContext, SpeedSource, TwinReport};
 use crate::twin::diagnose::{combine, fit_record, TwinDiagnosis};

@@ -1,5 +1,6 @@
 //! The config module from the outside: the default file, defaults, and what users see when a
 //! file is wrong.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::BandSelection;
 use bearingd::config::{

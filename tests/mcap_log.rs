@@ -6,22 +6,22 @@
 //! Python comes from `.venv/bin/python` (made by `.ci/run` from `scripts/requirements-ci.txt`).
 //! Under `CI=true` a missing venv or package fails the test and says what is missing; elsewhere
 //! the Python half is skipped with a note.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-use bearingd::daemon::messages::*;
-use bearingd::mcap_log::{
-    self, is_finished, read_messages, read_raw_blocks, recover_directory, LoggerConfig, McapLogger,
+use bearingd::mcap_log::{self, read_messages, read_raw_blocks};
+use bearingd::messages::*;
+use bearingd::sinks::mcap::{
+    self as mcap_sink, is_finished, recover_directory, LoggerConfig, McapLogger,
 };
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 
 const T0: u64 = 1_795_000_000_000_000_000; // 2026-11-18, ns since the epoch
 
-use bearingd::recording::testdata::{
-    check_mcap_with_python as python_check, python_mcap as python,
-};
+use bearingd_testdata::{check_mcap_with_python as python_check, python_mcap as python};
 
 fn ch(sensor: &str, axis: &str) -> ChannelId {
     ChannelId {
@@ -73,7 +73,7 @@ fn every_type() -> Vec<PipelineMessage> {
         PipelineMessage::Twin(TwinMessage {
             channel: c.clone(),
             end_sample: 51_200,
-            hypothesis: "outer_race".into(),
+            hypothesis: FaultKind::OuterRace,
             error: 0.01,
             margin: 0.5,
             error_outer_race: 0.01,
@@ -92,23 +92,23 @@ fn every_type() -> Vec<PipelineMessage> {
         PipelineMessage::Flag(FlagMessage {
             channel: c.clone(),
             end_sample: 76_800,
-            fault: "outer_race".into(),
-            from: "watch".into(),
-            to: "alarm".into(),
+            fault: FaultKind::OuterRace,
+            from: FlagLevel::Watch,
+            to: FlagLevel::Alarm,
             score: 37.5,
             fault_frequency_hz: 107.36,
         }),
         PipelineMessage::Health(HealthMessage {
             channel: c.clone(),
             end_sample: 1,
-            kind: "stage".into(),
-            stage: Some("degrading".into()),
+            kind: HealthKind::Stage,
+            stage: Some(HealthStage::Degrading),
             detail: "score over 15 for 10 min".into(),
         }),
         PipelineMessage::Health(HealthMessage {
             channel: c,
             end_sample: 2,
-            kind: "gap".into(),
+            kind: HealthKind::Gap,
             stage: None,
             detail: "12 samples missing".into(),
         }),
@@ -128,14 +128,14 @@ fn every_type() -> Vec<PipelineMessage> {
         PipelineMessage::Speed(SpeedMessage {
             channel: ch("motor-de", "radial"),
             end_sample: 25_600,
-            source: "can".into(),
+            source: SpeedSource::Can,
             given_rpm: Some(1772.25),
             rpm: Some(1772.25),
         }),
         PipelineMessage::Speed(SpeedMessage {
             channel: ch("motor-de", "radial"),
             end_sample: 51_200,
-            source: "can".into(),
+            source: SpeedSource::Can,
             given_rpm: None,
             rpm: None,
         }),
@@ -362,7 +362,7 @@ fn log_files(dir: &Path) -> Vec<(String, u64)> {
     let mut v: Vec<_> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap())
-        .filter(|e| mcap_log::writer::is_log_file_name(&e.file_name().to_string_lossy()))
+        .filter(|e| mcap_log::is_log_file_name(&e.file_name().to_string_lossy()))
         .map(|e| {
             (
                 e.file_name().to_string_lossy().into_owned(),
@@ -555,7 +555,7 @@ fn damaged_and_garbage_files_never_panic() {
             // Recovery of a damaged file either succeeds or reports a typed error (every 8th
             // position: it fsyncs).
             if k % 8 == 0 {
-                let _ = mcap_log::recover_file(&bad_file);
+                let _ = mcap_sink::recover_file(&bad_file);
             }
         }
     }
@@ -664,7 +664,7 @@ fn bytes_per_day_of_one_25k6_channel() {
             let m = TwinMessage {
                 channel: c.clone(),
                 end_sample: end,
-                hypothesis: "outer_race".into(),
+                hypothesis: FaultKind::OuterRace,
                 error: 0.011,
                 margin: 0.52,
                 error_outer_race: 0.011,

@@ -1,4 +1,5 @@
 //! Renders a synthetic diagnosis figure to SVG and PNG and checks what comes out.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use std::path::Path;
 

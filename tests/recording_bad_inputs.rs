@@ -1,10 +1,11 @@
 //! The readers on synthetic and damaged files, written to a scratch directory: every bad input
 //! must give a typed error (or a warning) that names the problem, and nothing may panic.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use bearingd::recording::testdata::{scratch_dir, shared_data_dir};
 use bearingd::recording::{
     list_channels, read_recording, ReadOptions, Recording, RecordingError, RecordingFormat,
 };
+use bearingd_testdata::{scratch_dir, shared_data_dir};
 use std::path::{Path, PathBuf};
 
 fn channel(name: &str) -> ReadOptions {

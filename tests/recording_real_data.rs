@@ -1,8 +1,9 @@
 //! The readers against the real shared data sets (../shared/data, never committed).
-//! Missing data: a loud skip locally, a failure with CI=true (see `testdata::shared_data_dir`).
+//! Missing data: a loud skip locally, a failure with CI=true (see `bearingd_testdata::shared_data_dir`).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use bearingd::recording::testdata::shared_data_dir;
 use bearingd::recording::{list_channels, read_recording, ReadOptions, RecordingFormat};
+use bearingd_testdata::shared_data_dir;
 use std::path::Path;
 
 fn channel(name: &str) -> ReadOptions {
@@ -13,7 +14,7 @@ fn channel(name: &str) -> ReadOptions {
 }
 
 fn manifest(dir: &Path) -> Vec<std::collections::HashMap<String, String>> {
-    bearingd::recording::testdata::read_manifest(dir)
+    bearingd_testdata::read_manifest(dir)
 }
 
 #[test]

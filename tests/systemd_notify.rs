@@ -3,6 +3,7 @@
 //!
 //! Why a real process and a real socket: what matters is what systemd would receive (the
 //! datagrams, their order, the watchdog pings while the pipeline runs), not the calls inside.
+#![allow(unsafe_code, clippy::unwrap_used, clippy::expect_used)]
 
 use std::os::unix::net::UnixDatagram;
 use std::path::Path;

@@ -3,6 +3,7 @@
 //! fault scorer, and while a channel monitor takes hops and speed changes between two band
 //! selections. (Its own test binary, because a global allocator is per binary; allocations are counted per
 //! thread, the analysis runs on the test's.)
+#![allow(unsafe_code, clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::envelope::RollingEnvelope;
 use bearingd::analysis::fault_bands::FaultScorer;

@@ -13,7 +13,8 @@
 //! leader does not explain, or the leader is `min_score_ratio` times stronger. Two detected,
 //! inseparable hypotheses give `none` with both named: a close call is said, never guessed.
 
-use super::fault_bands::{FaultKind, FaultScore};
+use super::fault_bands::FaultScore;
+use crate::messages::FaultKind;
 use serde::Serialize;
 
 /// What the analysis concludes.

@@ -24,69 +24,8 @@
 //! so a runner-up is judged only on evidence the winner does not explain.
 
 use crate::bearing::FaultFrequencies;
+use crate::messages::FaultKind;
 use serde::Serialize;
-
-/// The fault classes that have a characteristic frequency.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FaultKind {
-    OuterRace,
-    InnerRace,
-    Ball,
-    Cage,
-}
-
-impl FaultKind {
-    pub const ALL: [FaultKind; 4] = [
-        FaultKind::OuterRace,
-        FaultKind::InnerRace,
-        FaultKind::Ball,
-        FaultKind::Cage,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            FaultKind::OuterRace => "outer_race",
-            FaultKind::InnerRace => "inner_race",
-            FaultKind::Ball => "ball",
-            FaultKind::Cage => "cage",
-        }
-    }
-
-    /// The kind whose [`name`](Self::name) is `name`.
-    pub fn from_name(name: &str) -> Option<FaultKind> {
-        FaultKind::ALL.into_iter().find(|f| f.name() == name)
-    }
-
-    /// The short label engineers use for the frequency: BPFO, BPFI, 2BSF (twice the ball spin frequency), FTF.
-    pub fn frequency_label(self) -> &'static str {
-        match self {
-            FaultKind::OuterRace => "BPFO",
-            FaultKind::InnerRace => "BPFI",
-            FaultKind::Ball => "2BSF",
-            FaultKind::Cage => "FTF",
-        }
-    }
-
-    /// The repetition frequency of this fault's impacts.
-    pub fn frequency(self, f: &FaultFrequencies) -> f64 {
-        match self {
-            FaultKind::OuterRace => f.bpfo,
-            FaultKind::InnerRace => f.bpfi,
-            FaultKind::Ball => f.two_bsf,
-            FaultKind::Cage => f.ftf,
-        }
-    }
-
-    /// The modulation that makes sidebands around this fault's harmonics, if any.
-    pub fn sideband_spacing(self, f: &FaultFrequencies) -> Option<f64> {
-        match self {
-            FaultKind::InnerRace => Some(f.shaft),
-            FaultKind::Ball => Some(f.ftf),
-            FaultKind::OuterRace | FaultKind::Cage => None,
-        }
-    }
-}
 
 /// Most harmonics a score may use.
 pub const MAX_HARMONICS: usize = 10;

@@ -6,32 +6,8 @@
 //! of its current level for `off_delay` samples. Scores between the two thresholds change
 //! nothing: that band is the hysteresis that keeps a flag from chattering around a threshold.
 
+use crate::messages::FlagLevel;
 use serde::Serialize;
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum FlagLevel {
-    Ok,
-    Watch,
-    Alarm,
-}
-
-impl FlagLevel {
-    pub fn name(self) -> &'static str {
-        match self {
-            FlagLevel::Ok => "ok",
-            FlagLevel::Watch => "watch",
-            FlagLevel::Alarm => "alarm",
-        }
-    }
-
-    /// The level whose [`name`](Self::name) is `name`.
-    pub fn from_name(name: &str) -> Option<FlagLevel> {
-        [FlagLevel::Ok, FlagLevel::Watch, FlagLevel::Alarm]
-            .into_iter()
-            .find(|l| l.name() == name)
-    }
-}
 
 /// Thresholds and delays of a flag, delays already in samples.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -8,30 +8,8 @@
 //! damage does not heal) until the baseline is deliberately reset. The baseline is plain data
 //! ([`Baseline`]) so the daemon can keep it across restarts in its state directory.
 
+use crate::messages::HealthStage;
 use serde::{Deserialize, Serialize};
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum HealthStage {
-    /// Learning the healthy baseline.
-    Learning,
-    Healthy,
-    /// Kurtosis beyond the healthy baseline: impacts have appeared.
-    Degrading,
-    /// RMS beyond its level at the start of degradation: the damage has spread.
-    Failing,
-}
-
-impl HealthStage {
-    pub fn name(self) -> &'static str {
-        match self {
-            HealthStage::Learning => "learning",
-            HealthStage::Healthy => "healthy",
-            HealthStage::Degrading => "degrading",
-            HealthStage::Failing => "failing",
-        }
-    }
-}
 
 /// Mean and standard deviation of a statistic over a number of windows (Welford).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]

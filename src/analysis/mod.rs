@@ -28,6 +28,6 @@ pub mod speed;
 
 pub use band::Band;
 pub use diagnosis::{Diagnosis, Verdict};
-pub use fault_bands::{FaultKind, FaultScore};
+pub use fault_bands::FaultScore;
 pub use record::{analyze_record, AnalysisError, RecordAnalysis};
 pub use settings::{AnalysisSettings, BandSelection};

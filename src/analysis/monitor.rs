@@ -32,7 +32,7 @@
 use super::diagnosis::Contest;
 use super::envelope::FftPlans;
 use super::envelope::{window_samples, RollingEnvelope};
-use super::fault_bands::{FaultKind, FaultScore, FaultScorer};
+use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::{FaultFlag, FlagChange, FlagSettings};
 use super::health::{Baseline, HealthTracker, StageChange};
 use super::indicators::Indicators;
@@ -40,6 +40,7 @@ use super::record::{analyze_with_plans, envelope_range_hz};
 use super::speed::{estimate_shaft_hz, SpeedSearch};
 use super::{AnalysisSettings, Band};
 use crate::bearing::FaultFrequencies;
+use crate::messages::{FaultKind, FlagLevel, HealthKind};
 
 /// Everything a monitor needs, with durations already in samples.
 #[derive(Debug, Clone)]
@@ -98,11 +99,11 @@ pub enum SensorCondition {
     FlatLine,
 }
 
-impl SensorCondition {
-    pub fn name(self) -> &'static str {
-        match self {
-            SensorCondition::Clipping => "saturation",
-            SensorCondition::FlatLine => "flat_line",
+impl From<SensorCondition> for HealthKind {
+    fn from(condition: SensorCondition) -> HealthKind {
+        match condition {
+            SensorCondition::Clipping => HealthKind::Saturation,
+            SensorCondition::FlatLine => HealthKind::FlatLine,
         }
     }
 }
@@ -333,7 +334,7 @@ impl ChannelMonitor {
         self.bands_known.then_some(&self.bands)
     }
 
-    pub fn flag_levels(&self) -> [super::flags::FlagLevel; 4] {
+    pub fn flag_levels(&self) -> [FlagLevel; 4] {
         self.flags.each_ref().map(|f| f.level())
     }
 

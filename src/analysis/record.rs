@@ -9,11 +9,12 @@
 use super::band::Band;
 use super::diagnosis::{diagnose, Contest, Diagnosis};
 use super::envelope::{window_samples, EnvelopeSpectrum, FftPlans};
-use super::fault_bands::{FaultKind, FaultScore, FaultScorer};
+use super::fault_bands::{FaultScore, FaultScorer};
 use super::indicators::Indicators;
 use super::kurtogram::{band_tree, scan_bands, BandScan, TreeLevel};
 use super::settings::{AnalysisSettings, BandSelection};
 use crate::bearing::FaultFrequencies;
+use crate::messages::FaultKind;
 
 /// Why a record could not be analysed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -7,12 +7,12 @@
 
 use super::run::embedded_config;
 use super::CliError;
-use crate::alerts::payload::AlertDecodeError;
-use crate::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
-use crate::alerts::{Alert, AlertState};
 use crate::config;
-use crate::ingest::shm::IoxSettings;
-use crate::mcap_log::wall_clock_now_ns;
+use crate::iox::IoxSettings;
+use crate::sinks::alerts::payload::AlertDecodeError;
+use crate::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
+use crate::sinks::alerts::{Alert, AlertState};
+use crate::sources::wall_clock_now_ns;
 use clap::Args;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -49,10 +49,7 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
     };
     let settings = AlertServiceSettings {
         service: config.outputs.alerts_service.clone(),
-        iox: IoxSettings {
-            prefix: std::env::var("BEARINGD_IOX_PREFIX").ok(),
-            root_path: Some(config.outputs.iceoryx2_root.display().to_string()),
-        },
+        iox: IoxSettings::with_root(&config.outputs.iceoryx2_root),
     };
     if let Some(t) = args.timeout {
         if !(t.is_finite() && t >= 0.0) {
@@ -168,6 +165,10 @@ fn open_when_available(
 /// the daemon (not root, no capabilities) cannot connect to a subscriber that root created:
 /// such a subscriber would silently receive nothing. Nothing is done for other users; they
 /// must run as the daemon's user themselves (`sudo -u bearingd bearingd alerts`).
+#[allow(
+    unsafe_code,
+    reason = "geteuid, setgroups, setgid and setuid have no safe std API"
+)]
 fn act_as_daemon_user(settings: &AlertServiceSettings) -> Result<(), CliError> {
     use std::os::unix::fs::MetadataExt;
     // SAFETY: geteuid has no preconditions.

@@ -3,10 +3,10 @@
 //! (`bearingd replay DIR/*.mcap --config DIR/replay.toml`).
 
 use super::{CliError, RecordingArgs};
-use crate::daemon::messages::{ChannelId, PipelineMessage, RawBlock};
-use crate::mcap_log::{LoggerConfig, McapLogger};
+use crate::messages::{ChannelId, PipelineMessage, RawBlock};
 use crate::offline::{resolve_conditions, AnalyzeRequest};
 use crate::recording::read_recording;
+use crate::sinks::mcap::{LoggerConfig, McapLogger};
 use clap::Args;
 use std::path::PathBuf;
 

@@ -2,7 +2,7 @@
 //! the box?"), with optional expectations for tests and a non-zero exit when one fails.
 
 use super::CliError;
-use crate::ingest::{IngestEvent, SourceSummary};
+use crate::sources::{IngestEvent, SourceSummary};
 use clap::Args;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -209,7 +209,7 @@ fn start_source(
     if let Some(interface) = &args.can {
         #[cfg(feature = "can")]
         {
-            use crate::ingest::can;
+            use crate::sources::can;
             let capture: Option<Box<dyn std::io::Write + Send>> = match args.capture.as_deref() {
                 None => None,
                 Some("-") => Some(Box::new(std::io::stdout())),
@@ -246,10 +246,10 @@ fn start_source(
     let sensor = args.shm.clone().unwrap_or_default();
     #[cfg(feature = "shm")]
     {
-        use crate::ingest::{handoff::WhenFull, shm};
+        use crate::sources::{handoff::WhenFull, shm};
         let config = shm::ShmSourceConfig {
             sensor: sensor.clone(),
-            iox: shm::IoxSettings {
+            iox: crate::iox::IoxSettings {
                 prefix: args.iox_prefix.clone(),
                 root_path: args.iox_root.clone(),
             },

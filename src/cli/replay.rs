@@ -1,10 +1,11 @@
 //! `bearingd replay LOG.mcap...`: logged raw samples through the same pipeline, into a new log.
 
+use super::run::print_events;
 use super::CliError;
 use crate::config::{self, Config};
-use crate::daemon::mcap_sink::McapSink;
-use crate::daemon::replay::{replay, ReplayOptions};
-use crate::daemon::run::{logger_config, Sink};
+use crate::daemon::{replay, ReplayOptions};
+use crate::pipeline::Sink;
+use crate::sinks::mcap::McapSink;
 use clap::Args;
 use std::path::PathBuf;
 
@@ -51,18 +52,14 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
         }
     }
     config.outputs.mcap_dir = args.out.clone();
-    let rates = config
-        .sensors
-        .iter()
-        .map(|s| (s.id.clone(), s.sample_rate_hz))
-        .collect();
-    let (sink, _) = McapSink::open(logger_config(&config), rates, 0).map_err(CliError::input)?;
+    let (sink, _) = McapSink::for_config(&config, 0).map_err(CliError::input)?;
     let mut sinks: Vec<Box<dyn Sink>> = vec![Box::new(sink)];
     let options = ReplayOptions {
         speed: args.speed,
         progress: !args.quiet,
     };
-    let summary = replay(&args.files, &config, &options, &mut sinks).map_err(CliError::failure)?;
+    let summary = replay(&args.files, &config, &options, &mut sinks, &print_events())
+        .map_err(CliError::failure)?;
     let read = &summary.read;
     if args.json {
         let flags: Vec<_> = summary.flags.iter().collect();

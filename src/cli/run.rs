@@ -3,10 +3,13 @@
 
 use super::CliError;
 use crate::config::{self, Config};
-use crate::daemon::messages::PipelineMessage;
-use crate::daemon::run::{run, status_line, RunOptions, Sink};
+use crate::daemon::state::StateError;
+use crate::daemon::{run, DaemonEvent, Events, RunOptions};
+use crate::messages::{HealthKind, PipelineMessage, SpeedSource};
+use crate::pipeline::{ChannelStatus, Sink, SinkError};
 use clap::Args;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 #[derive(Args)]
 pub struct RunArgs {
@@ -37,12 +40,7 @@ impl Sink for FlagPrinter {
                 "FLAG {}: {} {} -> {} (score {:.1}, {:.1} Hz) at sample {}",
                 f.channel, f.fault, f.from, f.to, f.score, f.fault_frequency_hz, f.end_sample
             ),
-            PipelineMessage::Health(h)
-                if matches!(
-                    h.kind.as_str(),
-                    "stage" | "lost" | "back" | "gap" | "restart" | "saturation" | "flat_line"
-                ) =>
-            {
+            PipelineMessage::Health(h) if h.kind != HealthKind::Bands => {
                 println!(
                     "HEALTH {}: {} at sample {}",
                     h.channel, h.detail, h.end_sample
@@ -52,7 +50,7 @@ impl Sink for FlagPrinter {
         }
     }
 
-    fn finish(&mut self) -> Result<(), String> {
+    fn finish(&mut self) -> Result<(), SinkError> {
         Ok(())
     }
 }
@@ -77,7 +75,7 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         let shutdown = shutdown_signal().map_err(|e| {
             CliError::failure(format!("cannot install the SIGINT/SIGTERM handlers: {e}"))
         })?;
-        run(config, options, sinks, shutdown)
+        run(config, options, sinks, print_events(), shutdown)
             .await
             .map_err(CliError::input)
     })?;
@@ -143,4 +141,105 @@ fn data_dir(given: Option<&Path>) -> PathBuf {
 pub(super) fn embedded_config(data_dir_arg: Option<&Path>) -> Result<Config, CliError> {
     let data = data_dir(data_dir_arg);
     Config::embedded_in(&data).map_err(CliError::input)
+}
+
+/// The daemon's events as lines: status lines on stdout, everything else on stderr (the
+/// journal under systemd).
+pub(super) fn print_events() -> Events {
+    Arc::new(|event| match event {
+        DaemonEvent::Status(board) => {
+            for channel in &board {
+                println!("{}", status_line(channel));
+            }
+        }
+        other => eprintln!("{}", event_line(&other)),
+    })
+}
+
+/// How an event other than a status reads on stderr.
+fn event_line(event: &DaemonEvent) -> String {
+    match event {
+        DaemonEvent::Recovered(report) => format!(
+            "bearingd: recovered {}: {} messages kept, {} bytes unreadable{}",
+            report.path.display(),
+            report.messages_recovered,
+            report.unreadable_bytes,
+            report
+                .problem
+                .as_ref()
+                .map(|(at, why)| format!(" (from byte {at}: {why})"))
+                .unwrap_or_default()
+        ),
+        DaemonEvent::LoggingTo(path) => format!("bearingd: logging to {}", path.display()),
+        DaemonEvent::AlertsOn { service, root } => format!(
+            "bearingd: alerts on iceoryx2 service {service} (root {})",
+            root.display()
+        ),
+        DaemonEvent::NoAlertService => {
+            "bearingd: built without the `shm` feature: no iceoryx2 alerts are published".into()
+        }
+        #[cfg(feature = "shm")]
+        DaemonEvent::AlertDropped(dropped) => format!("bearingd: {dropped}"),
+        #[cfg(feature = "shm")]
+        DaemonEvent::AlertFailed(error) => format!("bearingd: {error}"),
+        DaemonEvent::SourceStopped { source, error } => {
+            format!("bearingd: {source} stopped: {error}")
+        }
+        DaemonEvent::SourceTaskFailed(error) => format!("bearingd: a source task failed: {error}"),
+        DaemonEvent::UnknownChannel { channel, blocks } => format!(
+            "bearingd: {blocks} blocks of {channel} skipped: no such sensor/axis in the config"
+        ),
+        DaemonEvent::State(problem @ StateError::Unreadable { .. }) => {
+            format!("bearingd: warning: {problem}; health baselines are learned again")
+        }
+        DaemonEvent::State(problem) => format!("bearingd: warning: {problem}"),
+        DaemonEvent::Notify(problem) => format!("bearingd: {problem}"),
+        DaemonEvent::Status(board) => board.iter().map(status_line).collect::<Vec<_>>().join("\n"),
+        DaemonEvent::ReplayUnreadable(error) => format!("bearingd: replay: {error}"),
+        DaemonEvent::ReplayProgress {
+            sample_seconds,
+            elapsed_s,
+            raw_blocks,
+            flag_changes,
+        } => format!(
+            "replay: {:.0} s of signal in {:.1} s ({:.0}× real time), {} blocks, {} flag changes",
+            sample_seconds,
+            elapsed_s,
+            sample_seconds / elapsed_s.max(1e-9),
+            raw_blocks,
+            flag_changes
+        ),
+    }
+}
+
+/// One channel's status in one line.
+pub fn status_line(s: &ChannelStatus) -> String {
+    let band = s.band_hz.map_or("learning".to_string(), |b| {
+        format!("{:.0}-{:.0} Hz", b[0], b[1])
+    });
+    let top = s
+        .top_fault
+        .map_or("-".to_string(), |f| format!("{f} {:.1}", s.top_score));
+    let twin = match (&s.twin_hypothesis, s.twin_error) {
+        (Some(h), Some(e)) => format!("{h} err {e:.3}"),
+        _ => "-".into(),
+    };
+    let rpm = match (s.rpm, s.speed_source) {
+        (Some(rpm), SpeedSource::Fixed) => format!("{rpm:.0}"),
+        (Some(rpm), source) => format!("{rpm:.0}({source})"),
+        (None, SpeedSource::Estimate) => "?(no estimate yet: scoring waits)".to_string(),
+        (None, _) => "?(no usable speed frame: scoring waits)".to_string(),
+    };
+    format!(
+        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} flags={}{}",
+        s.channel,
+        s.seconds,
+        rpm,
+        band,
+        top,
+        twin,
+        s.stage,
+        s.flags_summary(),
+        if s.sensor_lost { " SENSOR LOST" } else { "" }
+    )
 }

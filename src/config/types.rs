@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use crate::analysis::AnalysisSettings;
 use crate::bearing::BearingGeometry;
+use crate::messages::SpeedSource;
 
 /// A complete, validated configuration.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -24,6 +25,21 @@ pub struct Config {
     pub thresholds: ThresholdConfig,
     /// Where results go (`[outputs]`).
     pub outputs: OutputConfig,
+}
+
+impl Config {
+    /// The sample rate of every sensor, by id.
+    pub fn sample_rates(&self) -> std::collections::HashMap<String, f64> {
+        self.sensors
+            .iter()
+            .map(|s| (s.id.clone(), s.sample_rate_hz))
+            .collect()
+    }
+
+    /// How many channels (sensor axes) the config analyses.
+    pub fn channel_count(&self) -> usize {
+        self.sensors.iter().map(|s| s.axes.len()).sum()
+    }
 }
 
 /// One accelerometer (`[[sensors]]`).
@@ -166,12 +182,12 @@ impl Speed {
         }
     }
 
-    /// The name of the source, as in the config.
-    pub fn source_name(&self) -> &'static str {
+    /// Where the speed comes from (the config's `source`).
+    pub fn source(&self) -> SpeedSource {
         match self {
-            Speed::Fixed { .. } => "fixed",
-            Speed::Frames { .. } => "can",
-            Speed::Estimate { .. } => "estimate",
+            Speed::Fixed { .. } => SpeedSource::Fixed,
+            Speed::Frames { .. } => SpeedSource::Can,
+            Speed::Estimate { .. } => SpeedSource::Estimate,
         }
     }
 }

@@ -1,22 +1,17 @@
-//! The running service (`bearingd run`, `bearingd replay`): sources → per-channel analysis →
-//! sinks.
+//! The running service, wiring only: `bearingd run` ([`run`]) and `bearingd replay`
+//! ([`replay`]) put sources, the pipeline and sinks together, start and stop them.
 //!
-//! - [`live_source`]: the SocketCAN and iceoryx2 sources mapped onto the config's channels.
-//! - [`mcap_sink`]: the MCAP log as a sink (time mapping, flushes, recovery at start).
-//! - [`replay`]: logged raw samples through the same pipeline.
-//! - [`messages`]: what flows to the sinks; the MCAP log's schema.
-//! - [`notify`]: the systemd notify protocol (READY, STATUS, WATCHDOG, STOPPING).
-//! - [`pipeline`]: the analysis stage shared by `run` and `replay` (sample time only).
 //! - [`run`]: threads, queues, shutdown and status of `bearingd run`.
-//! - [`sim_source`]: the in-process simulated sensor node.
-//! - [`twin_worker`]: the twin's periodic re-fit.
+//! - [`replay`]: logged raw samples through the same pipeline, into the same sinks.
+//! - [`events`]: what the daemon tells its operator, as typed events for the caller to show
+//!   (the daemon never prints).
+//! - [`state`]: what is kept across restarts (the health baselines).
 
-pub mod live_source;
-pub mod mcap_sink;
-pub mod messages;
-pub mod notify;
-pub mod pipeline;
+pub mod events;
 pub mod replay;
 pub mod run;
-pub mod sim_source;
-pub mod twin_worker;
+pub mod state;
+
+pub use events::{ignore_events, DaemonEvent, Events};
+pub use replay::{replay, ReplayError, ReplayOptions, ReplaySummary};
+pub use run::{run, RunError, RunOptions, RunSummary};

@@ -1,42 +1,52 @@
 //! `bearingd run`: sources → the analysis thread → the sink thread, with the twin's re-fits on
 //! their own thread and status on the async side.
 //!
-//! Threads and queues (every queue bounded, its policy declared):
-//! - async (tokio): sources, signals, status lines. Sources send into the analysis queue and
-//!   wait when it is full (`Block`): an in-process source is simply slowed; a transport source
-//!   then backs up into its own buffer, where a loss shows as an exact sequence gap.
-//! - analysis thread: the [`Pipeline`]; hands messages to the sink queue (`Block`), flag changes
-//!   as alerts to the alert queue (`DropNewest`, counted and reported; alerts are rare), and
-//!   twin requests to the re-fit queue (`DropNewest`: a request that finds the re-fit thread
-//!   busy is skipped and counted; the next period brings a fresh one). Each input carries the
-//!   wall-clock time its source completed it ([`Arrived`]); alerts carry that time of the
-//!   block that decided them, so their latency includes any wait in the queue. The analysis
-//!   never sees it.
-//! - alert thread: the iceoryx2 publisher of `outputs.alerts_service` ([`crate::alerts`]).
-//!   Alerts skip the sink queue so that MCAP compression never delays them.
-//! - re-fit thread: [`TwinWorker`]; its results go to the sink queue, and back to the analysis
-//!   thread (status, alert confidence) through a hand-over list that holds at most the fits of
-//!   one request per channel.
+//! [`run`] is a sequence of named steps: prepare the state directory, open the log, start the
+//! alert service, start the three threads, start the sources, supervise until a stop, stop in
+//! order. Each thread owns its state and talks to the others over bounded channels only:
+//!
+//! - async (tokio): sources, signals, status. Sources send into the analysis queue
+//!   ([`ANALYSIS_QUEUE`]) and wait when it is full (`Block`): an in-process source is simply
+//!   slowed; a transport source then backs up into its own buffer, where a loss shows as an
+//!   exact sequence gap.
+//! - analysis thread ([`AnalysisThread`]): owns the [`Pipeline`] and the alert sink; hands
+//!   messages to the sink queue (`Block`), flag changes straight to the alert publisher
+//!   (`DropNewest`, counted and reported; alerts are rare), and twin requests to the re-fit
+//!   queue (capacity 1, `DropNewest`: a request that finds the re-fit thread busy is skipped and
+//!   counted; the next period brings a fresh one). Each input carries the wall-clock time its
+//!   source completed it ([`Arrived`]); alerts carry that time of the block that decided them,
+//!   so their latency includes any wait in the queue. The analysis never sees it. After every
+//!   input it publishes the channels' status on a `watch` channel (the latest value only).
+//! - alert thread: the iceoryx2 publisher of `outputs.alerts_service`
+//!   ([`crate::sinks::alerts`]). Alerts skip the sink queue so that MCAP compression never
+//!   delays them.
+//! - re-fit thread: [`TwinWorker`]; its fits go back to the analysis thread through a bounded
+//!   hand-over (one slot per channel, plus one; the re-fit thread waits when it is full), and
+//!   the analysis thread passes them on to the sinks, so that the sink queue has one producer.
 //! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
 //!   them at shutdown happens there.
+//!
+//! Stopping: the sources end (a signal, `--duration`, or all of them finished); their sender
+//! closing ends the analysis thread, which closes the re-fit queue, takes the last fits and
+//! closes the sink queue, which ends the sink thread.
 
-use super::live_source::{can_interfaces, forward, shm_sensors, Arrived, SENSOR_TIMEOUT};
-use super::mcap_sink::McapSink;
-use super::messages::{ChannelId, FlagMessage, PipelineMessage, TwinMessage};
-use super::notify::{keep_alive, Notifier};
-use super::pipeline::{ChannelStatus, Output, Pipeline, TwinRequest};
-use super::sim_source::SimSource;
-use super::twin_worker::TwinWorker;
-#[cfg(feature = "shm")]
-use crate::alerts::tracker::history_size_for;
-use crate::alerts::tracker::AlertTracker;
-use crate::analysis::health::Baseline;
+use super::events::{DaemonEvent, Events};
+use super::state::{load_baselines, save_baselines};
 use crate::config::{Config, Transport};
-use crate::mcap_log::{wall_clock_now_ns, LoggerConfig};
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{mpsc, Arc, Mutex};
+use crate::mcap_log::McapLogError;
+use crate::messages::{FlagMessage, PipelineMessage, TwinMessage};
+use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinRequest, TwinWorker};
+use crate::sinks::alerts::PublisherSummary;
+use crate::sinks::mcap::McapSink;
+use crate::sinks::systemd::{keep_alive, status_text, Notifier};
+use crate::sources::live::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
+use crate::sources::sim::SimSource;
+use crate::sources::{wall_clock_now_ns, Arrived};
+use std::path::PathBuf;
+use std::sync::mpsc;
+use std::time::Duration;
+use tokio::sync::{mpsc as async_mpsc, watch};
+use tokio::task::JoinSet;
 
 /// How `run` should behave beyond the config.
 #[derive(Debug, Clone, Default)]
@@ -45,26 +55,32 @@ pub struct RunOptions {
     pub duration_s: Option<f64>,
     /// Pace simulated sensors at real time (`true`) or as fast as the analysis allows.
     pub realtime: bool,
-    /// Print a status line per channel every `status_interval_s`.
+    /// Report every channel's status ([`DaemonEvent::Status`]) every `status_interval_s`.
     pub status_lines: bool,
 }
 
 /// Why `run` could not start or had to stop.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
+    #[cfg(feature = "can")]
     #[error("source: {0}")]
-    Source(String),
+    Can(#[from] crate::sources::can::CanSourceError),
+    #[error("source: {what}: this bearingd was built without the `{feature}` feature")]
+    NotBuilt { what: String, feature: &'static str },
     #[error("{path}: cannot create the directory: {source}; check its permissions or set outputs.state_dir / outputs.mcap_dir")]
     Directory {
         path: PathBuf,
         source: std::io::Error,
     },
     #[error("MCAP log: {0}")]
-    Log(String),
+    Log(#[from] McapLogError),
+    #[cfg(feature = "shm")]
     #[error("alerts: {0}")]
-    Alerts(String),
+    Alerts(#[from] crate::sinks::alerts::AlertError),
     #[error("{what} thread failed: {detail}")]
     Thread { what: &'static str, detail: String },
+    #[error("sink thread failed: {0}")]
+    Sink(#[from] SinkError),
 }
 
 /// What a run did, for the summary on exit.
@@ -81,366 +97,359 @@ pub struct RunSummary {
     pub alerts_dropped: u64,
 }
 
-/// A consumer of pipeline messages on the sink thread.
-pub trait Sink: Send {
-    fn write(&mut self, message: &PipelineMessage);
-    /// Flush and close; called once at shutdown.
-    fn finish(&mut self) -> Result<(), String>;
-}
-
-const ANALYSIS_QUEUE: usize = 64;
-const SINK_QUEUE: usize = 1024;
+/// Inputs waiting for the analysis thread, at most.
+pub const ANALYSIS_QUEUE: usize = 64;
+/// Messages waiting for the sink thread, at most.
+pub const SINK_QUEUE: usize = 1024;
 /// Length of a simulated sensor's block, in seconds of sample time.
 const SIM_BLOCK_S: f64 = 0.1;
 
-/// Runs until `shutdown` resolves or the duration is reached.
+/// Runs until `shutdown` resolves, the duration is reached or every source has ended; what
+/// the operator should know goes to `events`.
 pub async fn run(
     config: Config,
     options: RunOptions,
     mut sinks: Vec<Box<dyn Sink>>,
+    events: Events,
     shutdown: impl std::future::Future<Output = ()>,
 ) -> Result<RunSummary, RunError> {
-    let sims: Vec<SimSource> = config
-        .sensors
-        .iter()
-        .filter_map(|sensor| match &sensor.transport {
-            Transport::Sim(sim) => Some(SimSource::new(sensor, sim, SIM_BLOCK_S)),
-            _ => None,
-        })
-        .collect();
-    let state_dir = config.outputs.state_dir.clone();
-    std::fs::create_dir_all(&state_dir).map_err(|source| RunError::Directory {
-        path: state_dir.clone(),
-        source,
-    })?;
-    let rates = config
-        .sensors
-        .iter()
-        .map(|s| (s.id.clone(), s.sample_rate_hz))
-        .collect();
-    let (mcap, recovered) = McapSink::open(logger_config(&config), rates, wall_clock_now_ns())
-        .map_err(|e| RunError::Log(e.to_string()))?;
-    for report in &recovered {
-        eprintln!(
-            "bearingd: recovered {}: {} messages kept, {} bytes unreadable{}",
-            report.path.display(),
-            report.messages_recovered,
-            report.unreadable_bytes,
-            report
-                .problem
-                .as_ref()
-                .map(|(at, why)| format!(" (from byte {at}: {why})"))
-                .unwrap_or_default()
-        );
+    let state_dir = prepare_state_dir(&config)?;
+    sinks.push(Box::new(open_log(&config, &events)?));
+    let alerts = start_alerts(&config, &events)?;
+    let (baselines, problem) = load_baselines(&state_dir);
+    if let Some(problem) = problem {
+        events(DaemonEvent::State(problem));
     }
-    if let Some(path) = mcap.current_path() {
-        eprintln!("bearingd: logging to {}", path.display());
-    }
-    sinks.push(Box::new(mcap));
-    let baselines = load_baselines(&state_dir);
     let pipeline = Pipeline::new(&config, &baselines);
-    let status_board = Arc::new(Mutex::new(pipeline.status()));
-    // Fits made on the re-fit thread, waiting for the analysis thread to take them.
-    let fresh_twins: Arc<Mutex<Vec<TwinMessage>>> = Arc::default();
-    let alerts = start_alerts(&config)?;
-    let skipped = Arc::new(AtomicU64::new(0));
-    // Liveness for systemd's watchdog: the analysis thread bumps it after every input, the
-    // notify task reads it. An atomic, not the status board, because it must advance even when
-    // an input changes no status (a SensorLost, a short block).
-    let heartbeat = Arc::new(AtomicU64::new(0));
 
-    let (input_tx, mut input_rx) = tokio::sync::mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
+    let (input_tx, input_rx) = async_mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
     let (sink_tx, sink_rx) = mpsc::sync_channel::<PipelineMessage>(SINK_QUEUE);
-    let (twin_tx, twin_rx) = mpsc::sync_channel::<TwinRequest>(1);
+    let (request_tx, request_rx) = mpsc::sync_channel::<TwinRequest>(1);
+    let (fit_tx, fit_rx) = mpsc::sync_channel::<TwinMessage>(config.channel_count() + 1);
+    let (status_tx, status_rx) = watch::channel(pipeline.status());
 
-    // The analysis thread.
-    let analysis = {
-        let sink_tx = sink_tx.clone();
-        let status_board = status_board.clone();
-        let fresh_twins = fresh_twins.clone();
-        let skipped = skipped.clone();
-        let heartbeat = heartbeat.clone();
-        let state_dir = state_dir.clone();
-        std::thread::Builder::new()
-            .name("bearingd-analysis".into())
-            .spawn(move || {
-                let mut pipeline = pipeline;
-                let mut alerts = alerts;
-                while let Some(arrived) = input_rx.blocking_recv() {
-                    let arrived_ns = arrived.wall_ns;
-                    pipeline.handle(arrived.input, &mut |output| match output {
-                        Output::Message(m) => {
-                            if let Some((tracker, publisher)) = alerts.as_mut() {
-                                tracker.observe(&m, arrived_ns, &mut |a| publisher.send(a));
-                            }
-                            let _ = sink_tx.send(m);
-                        }
-                        Output::Twin(request) => {
-                            if twin_tx.try_send(request).is_err() {
-                                skipped.fetch_add(1, Ordering::Relaxed);
-                            }
-                        }
-                    });
-                    let fits = fresh_twins
-                        .lock()
-                        .map(|mut f| std::mem::take(&mut *f))
-                        .unwrap_or_default();
-                    for fit in &fits {
-                        pipeline.note_twin(&fit.channel, &fit.hypothesis, fit.error);
-                        if let Some((tracker, _)) = alerts.as_mut() {
-                            tracker.note_twin(fit);
-                        }
-                    }
-                    if let Ok(mut board) = status_board.lock() {
-                        *board = pipeline.status();
-                    }
-                    heartbeat.fetch_add(1, Ordering::Relaxed);
-                }
-                save_baselines(&state_dir, &pipeline.baselines());
-                for (channel, blocks) in pipeline.unknown_channels() {
-                    eprintln!("bearingd: {blocks} blocks of {channel} skipped: no such sensor/axis in the config");
-                }
-                alerts.map(|(_, publisher)| publisher.finish())
-            })
-            .map_err(|e| RunError::Thread {
-                what: "analysis",
-                detail: e.to_string(),
-            })?
+    let sink = spawn("sink", move || sink_thread(sinks, &sink_rx))?;
+    let refit = spawn("twin", move || refit_thread(&request_rx, &fit_tx))?;
+    let analysis = AnalysisThread {
+        pipeline,
+        alerts,
+        inputs: input_rx,
+        sinks: sink_tx,
+        twin_requests: Some(request_tx),
+        fits: fit_rx,
+        status: status_tx,
+        requests_skipped: 0,
+        state_dir,
+        events: events.clone(),
     };
-    // The twin's re-fit thread.
-    let refit = {
-        let sink_tx = sink_tx.clone();
-        let fresh_twins = fresh_twins.clone();
-        std::thread::Builder::new()
-            .name("bearingd-twin".into())
-            .spawn(move || {
-                let mut worker = TwinWorker::default();
-                let mut fits = 0u64;
-                while let Ok(request) = twin_rx.recv() {
-                    if let Some(message) = worker.refit(&request) {
-                        if let Ok(mut fresh) = fresh_twins.lock() {
-                            // At most one pending fit per channel: a newer one replaces it.
-                            fresh.retain(|f| f.channel != message.channel);
-                            fresh.push(TwinMessage {
-                                residual: Vec::new(),
-                                ..message.clone()
-                            });
-                        }
-                        fits += 1;
-                        let _ = sink_tx.send(PipelineMessage::Twin(message));
-                    }
-                }
-                fits
-            })
-            .map_err(|e| RunError::Thread {
-                what: "twin re-fit",
-                detail: e.to_string(),
-            })?
-    };
-    drop(sink_tx);
-    // The sink thread.
-    let sink = std::thread::Builder::new()
-        .name("bearingd-sink".into())
-        .spawn(move || {
-            let mut flags = Vec::new();
-            let mut messages = 0u64;
-            let mut errors = Vec::new();
-            while let Ok(message) = sink_rx.recv() {
-                messages += 1;
-                if let PipelineMessage::Flag(flag) = &message {
-                    flags.push(flag.clone());
-                }
-                for sink in sinks.iter_mut() {
-                    sink.write(&message);
-                }
-            }
-            for sink in sinks.iter_mut() {
-                if let Err(e) = sink.finish() {
-                    errors.push(e);
-                }
-            }
-            (flags, messages, errors)
-        })
-        .map_err(|e| RunError::Thread {
-            what: "sink",
-            detail: e.to_string(),
-        })?;
+    let analysis = spawn("analysis", move || analysis.run())?;
 
-    // Sources and status on the async side.
-    let (stop_tx, stop_rx) = tokio::sync::watch::channel(false);
-    let mut sources = tokio::task::JoinSet::new();
-    let live = start_live_sources(&config, &input_tx, &stop_rx, &mut sources)?;
-    if !sims.is_empty() {
-        sources.spawn(feed_simulated(
-            sims,
-            input_tx.clone(),
-            options.clone(),
-            stop_rx.clone(),
-        ));
-    }
+    let (stop_tx, stop_rx) = watch::channel(false);
+    let mut sources = JoinSet::new();
+    let live = start_live_sources(&config, &input_tx, &stop_rx, &mut sources, &events)?;
+    start_simulated(&config, &options, &input_tx, &stop_rx, &mut sources);
     // A weak handle on the analysis queue, to see whether inputs wait there; it does not keep
     // the queue open, so the analysis thread still ends when the sources do.
     let analysis_queue = input_tx.downgrade();
     drop(input_tx);
-    // systemd (Type=notify): ready once the log is open, the threads run and the sources are
-    // started. A no-op without $NOTIFY_SOCKET.
-    let notifier = Notifier::from_env();
-    notifier.ready();
-    let mut last_beat = 0;
-    let supervise = keep_alive(
-        &notifier,
-        std::time::Duration::from_secs_f64(config.outputs.status_interval_s),
-        || {
-            status_board
-                .lock()
-                .map(|b| systemd_status(&b))
-                .unwrap_or_default()
-        },
-        // The watchdog rule: alive if the analysis thread took an input since the last check,
-        // or if no input waits for it (a silent sensor is reported as lost, not cured by a
-        // restart). Inputs waiting and no progress for the whole WatchdogSec: no more pings.
-        || {
-            let beat = heartbeat.load(Ordering::Relaxed);
-            let progressed = beat != last_beat;
-            last_beat = beat;
-            let idle = analysis_queue
-                .upgrade()
-                .is_none_or(|queue| queue.capacity() == queue.max_capacity());
-            progressed || idle
-        },
-    );
-    let status = print_status(
-        status_board.clone(),
-        config.outputs.status_interval_s,
-        options.status_lines,
-    );
-    let live_deadline = async {
-        match options.duration_s.filter(|_| live) {
-            Some(seconds) => tokio::time::sleep(std::time::Duration::from_secs_f64(seconds)).await,
-            None => std::future::pending().await,
-        }
-    };
-    tokio::select! {
-        _ = async { while sources.join_next().await.is_some() {} } => {},
-        _ = shutdown => {},
-        _ = live_deadline => {},
-        _ = status => {},
-        _ = supervise => {},
-    }
-    notifier.stopping();
+
+    supervise(
+        &config,
+        &options,
+        live,
+        &mut sources,
+        status_rx.clone(),
+        analysis_queue,
+        &events,
+        shutdown,
+    )
+    .await;
     let _ = stop_tx.send(true);
     while let Some(finished) = sources.join_next().await {
         if let Err(e) = finished {
-            eprintln!("bearingd: a source task failed: {e}");
+            events(DaemonEvent::SourceTaskFailed(e.to_string()));
         }
     }
-    // Dropping the sources' sender (inside `feed`) ends the analysis thread, which ends the
-    // re-fit thread, which ends the sink thread.
-    let alert_summary = analysis.join().map_err(|_| RunError::Thread {
-        what: "analysis",
-        detail: "panicked".into(),
-    })?;
-    let twin_fits = refit.join().map_err(|_| RunError::Thread {
-        what: "twin re-fit",
-        detail: "panicked".into(),
-    })?;
-    let (flags, messages, errors) = sink.join().map_err(|_| RunError::Thread {
-        what: "sink",
-        detail: "panicked".into(),
-    })?;
-    if let Some(error) = errors.into_iter().next() {
-        return Err(RunError::Thread {
-            what: "sink",
-            detail: error,
-        });
-    }
-    let channels = status_board.lock().map(|b| b.clone()).unwrap_or_default();
+    // The sources' senders are gone: the analysis thread ends, which ends the re-fit thread
+    // and then the sink thread.
+    let analysis = join("analysis", analysis)?;
+    let twin_fits = join("twin re-fit", refit)?;
+    let (flags, messages) = join("sink", sink)??;
+    let channels = status_rx.borrow().clone();
     Ok(RunSummary {
         channels,
         flags,
         messages,
         twin_fits,
-        twin_requests_skipped: skipped.load(Ordering::Relaxed),
-        alerts_published: alert_summary.map_or(0, |s| s.published),
-        alerts_dropped: alert_summary.map_or(0, |s| s.dropped),
+        twin_requests_skipped: analysis.requests_skipped,
+        alerts_published: analysis.alerts.map_or(0, |s| s.published),
+        alerts_dropped: analysis.alerts.map_or(0, |s| s.dropped),
     })
 }
 
-/// The alert service's publisher and the tracker that feeds it.
-#[cfg(feature = "shm")]
-type Alerts = (AlertTracker, crate::alerts::service::AlertPublisher);
+/// Creates `outputs.state_dir` if it is missing.
+fn prepare_state_dir(config: &Config) -> Result<PathBuf, RunError> {
+    let state_dir = config.outputs.state_dir.clone();
+    std::fs::create_dir_all(&state_dir).map_err(|source| RunError::Directory {
+        path: state_dir.clone(),
+        source,
+    })?;
+    Ok(state_dir)
+}
 
-/// Creates the alert service `outputs.alerts_service` under `outputs.iceoryx2_root` (the file
-/// prefix from `$BEARINGD_IOX_PREFIX`, for isolated tests) and the tracker.
+/// Recovers what a crash left in the log directory and opens the log, sample 0 at now.
+fn open_log(config: &Config, events: &Events) -> Result<McapSink, RunError> {
+    let (log, recovered) = McapSink::for_config(config, wall_clock_now_ns())?;
+    for report in recovered {
+        events(DaemonEvent::Recovered(report));
+    }
+    if let Some(path) = log.current_path() {
+        events(DaemonEvent::LoggingTo(path.to_path_buf()));
+    }
+    Ok(log)
+}
+
+/// The alert service `outputs.alerts_service` under `outputs.iceoryx2_root`.
 #[cfg(feature = "shm")]
-fn start_alerts(config: &Config) -> Result<Option<Alerts>, RunError> {
-    use crate::alerts::service::{AlertPublisher, AlertServiceSettings};
-    use crate::ingest::shm::IoxSettings;
-    let channels: usize = config.sensors.iter().map(|s| s.axes.len()).sum();
-    let history = history_size_for(channels);
-    let settings = AlertServiceSettings {
-        service: config.outputs.alerts_service.clone(),
-        iox: IoxSettings {
-            prefix: std::env::var("BEARINGD_IOX_PREFIX").ok(),
-            root_path: Some(config.outputs.iceoryx2_root.display().to_string()),
-        },
+type AlertSink = crate::sinks::alerts::AlertSink;
+
+#[cfg(feature = "shm")]
+fn start_alerts(config: &Config, events: &Events) -> Result<Option<AlertSink>, RunError> {
+    let iox = crate::iox::IoxSettings::with_root(&config.outputs.iceoryx2_root);
+    let on_failure = {
+        let events = events.clone();
+        move |e| events(DaemonEvent::AlertFailed(e))
     };
-    let publisher = AlertPublisher::start(settings.clone(), history)
-        .map_err(|e| RunError::Alerts(e.to_string()))?;
-    eprintln!(
-        "bearingd: alerts on iceoryx2 service {} (root {})",
-        settings.service,
-        config.outputs.iceoryx2_root.display()
-    );
-    let rates = config
-        .sensors
-        .iter()
-        .map(|s| (s.id.clone(), s.sample_rate_hz))
-        .collect();
-    let tracker = AlertTracker::new(wall_clock_now_ns(), history, &config.analysis, rates);
-    Ok(Some((tracker, publisher)))
+    let alerts = AlertSink::start(config, iox, wall_clock_now_ns(), on_failure)?;
+    events(DaemonEvent::AlertsOn {
+        service: config.outputs.alerts_service.clone(),
+        root: config.outputs.iceoryx2_root.clone(),
+    });
+    Ok(Some(alerts))
 }
 
 /// Without iceoryx2 (the `shm` feature) there is no alert service; flags still go to the log.
 #[cfg(not(feature = "shm"))]
-type Alerts = (AlertTracker, NoPublisher);
+enum AlertSink {}
 
 #[cfg(not(feature = "shm"))]
-struct NoPublisher;
-
-#[cfg(not(feature = "shm"))]
-impl NoPublisher {
-    fn send(&self, _: crate::alerts::Alert) {}
-    fn finish(self) -> crate::alerts::PublisherSummary {
-        crate::alerts::PublisherSummary::default()
+impl AlertSink {
+    fn observe(
+        &mut self,
+        _: &PipelineMessage,
+        _: u64,
+        _: &mut impl FnMut(std::convert::Infallible),
+    ) {
+        match *self {}
+    }
+    fn note_twin(&mut self, _: &TwinMessage) {
+        match *self {}
+    }
+    fn finish(self) -> PublisherSummary {
+        match self {}
     }
 }
 
 #[cfg(not(feature = "shm"))]
-fn start_alerts(_config: &Config) -> Result<Option<Alerts>, RunError> {
-    eprintln!("bearingd: built without the `shm` feature: no iceoryx2 alerts are published");
+fn start_alerts(_config: &Config, events: &Events) -> Result<Option<AlertSink>, RunError> {
+    events(DaemonEvent::NoAlertService);
     Ok(None)
+}
+
+/// Starts a named thread of the daemon.
+fn spawn<T: Send + 'static>(
+    what: &'static str,
+    body: impl FnOnce() -> T + Send + 'static,
+) -> Result<std::thread::JoinHandle<T>, RunError> {
+    std::thread::Builder::new()
+        .name(format!("bearingd-{what}"))
+        .spawn(body)
+        .map_err(|e| RunError::Thread {
+            what,
+            detail: e.to_string(),
+        })
+}
+
+/// Waits for a thread of the daemon; its panic becomes an error.
+fn join<T>(what: &'static str, thread: std::thread::JoinHandle<T>) -> Result<T, RunError> {
+    thread.join().map_err(|_| RunError::Thread {
+        what,
+        detail: "panicked".into(),
+    })
+}
+
+/// What the analysis thread reports when it ends.
+struct AnalysisSummary {
+    requests_skipped: u64,
+    alerts: Option<PublisherSummary>,
+}
+
+/// The analysis thread's state: the pipeline, the alert sink and its ends of the queues.
+struct AnalysisThread {
+    pipeline: Pipeline,
+    alerts: Option<AlertSink>,
+    inputs: async_mpsc::Receiver<Arrived>,
+    sinks: mpsc::SyncSender<PipelineMessage>,
+    /// `None` once the inputs have ended (closing the re-fit queue).
+    twin_requests: Option<mpsc::SyncSender<TwinRequest>>,
+    fits: mpsc::Receiver<TwinMessage>,
+    status: watch::Sender<Vec<ChannelStatus>>,
+    requests_skipped: u64,
+    state_dir: PathBuf,
+    events: Events,
+}
+
+impl AnalysisThread {
+    fn run(mut self) -> AnalysisSummary {
+        while let Some(arrived) = self.inputs.blocking_recv() {
+            self.analyse(arrived);
+            while let Ok(fit) = self.fits.try_recv() {
+                self.take_fit(fit);
+            }
+            self.status.send_replace(self.pipeline.status());
+        }
+        self.stop()
+    }
+
+    /// One input through the pipeline; its outputs to the sinks, the alerts and the re-fit.
+    fn analyse(&mut self, arrived: Arrived) {
+        let AnalysisThread {
+            pipeline,
+            alerts,
+            sinks,
+            twin_requests,
+            requests_skipped,
+            events,
+            ..
+        } = self;
+        pipeline.handle(arrived.input, &mut |output| match output {
+            Output::Message(message) => {
+                if let Some(alerts) = alerts.as_mut() {
+                    alerts.observe(&message, arrived.wall_ns, &mut |dropped| {
+                        #[cfg(feature = "shm")]
+                        events(DaemonEvent::AlertDropped(dropped));
+                        #[cfg(not(feature = "shm"))]
+                        let _ = (dropped, &events);
+                    });
+                }
+                let _ = sinks.send(message);
+            }
+            Output::Twin(request) => {
+                let sent = twin_requests
+                    .as_ref()
+                    .is_some_and(|queue| queue.try_send(request).is_ok());
+                if !sent {
+                    *requests_skipped += 1;
+                }
+            }
+        });
+    }
+
+    /// A fit from the re-fit thread: into the channel's status and the alerts, then to the
+    /// sinks.
+    fn take_fit(&mut self, fit: TwinMessage) {
+        self.pipeline
+            .note_twin(&fit.channel, fit.hypothesis, fit.error);
+        if let Some(alerts) = self.alerts.as_mut() {
+            alerts.note_twin(&fit);
+        }
+        let _ = self.sinks.send(PipelineMessage::Twin(fit));
+    }
+
+    /// The inputs have ended: the last fits, the baselines, the unknown channels, the alerts.
+    fn stop(mut self) -> AnalysisSummary {
+        // Closing the re-fit queue ends the re-fit thread once it has handed over its last fit.
+        self.twin_requests = None;
+        while let Ok(fit) = self.fits.recv() {
+            self.take_fit(fit);
+        }
+        self.status.send_replace(self.pipeline.status());
+        if let Err(problem) = save_baselines(&self.state_dir, &self.pipeline.baselines()) {
+            (self.events)(DaemonEvent::State(problem));
+        }
+        for (channel, blocks) in self.pipeline.unknown_channels() {
+            (self.events)(DaemonEvent::UnknownChannel {
+                channel: channel.clone(),
+                blocks: *blocks,
+            });
+        }
+        AnalysisSummary {
+            requests_skipped: self.requests_skipped,
+            alerts: self.alerts.map(AlertSink::finish),
+        }
+    }
+}
+
+/// The re-fit thread: one request at a time, each fit handed back to the analysis thread.
+/// Returns the number of fits made.
+fn refit_thread(
+    requests: &mpsc::Receiver<TwinRequest>,
+    fits: &mpsc::SyncSender<TwinMessage>,
+) -> u64 {
+    let mut worker = TwinWorker::default();
+    let mut made = 0u64;
+    while let Ok(request) = requests.recv() {
+        if let Some(fit) = worker.refit(&request) {
+            made += 1;
+            if fits.send(fit).is_err() {
+                break;
+            }
+        }
+    }
+    made
+}
+
+/// The sink thread: every message to every sink, then finishes them. Returns the flag changes
+/// and the number of messages.
+fn sink_thread(
+    mut sinks: Vec<Box<dyn Sink>>,
+    messages: &mpsc::Receiver<PipelineMessage>,
+) -> Result<(Vec<FlagMessage>, u64), SinkError> {
+    let mut flags = Vec::new();
+    let mut count = 0u64;
+    while let Ok(message) = messages.recv() {
+        count += 1;
+        if let PipelineMessage::Flag(flag) = &message {
+            flags.push(flag.clone());
+        }
+        for sink in sinks.iter_mut() {
+            sink.write(&message);
+        }
+    }
+    let mut first_error = None;
+    for sink in sinks.iter_mut() {
+        if let Err(e) = sink.finish() {
+            first_error.get_or_insert(e);
+        }
+    }
+    match first_error {
+        None => Ok((flags, count)),
+        Some(e) => Err(e),
+    }
 }
 
 /// Starts the SocketCAN and iceoryx2 sources of the config; `true` if there is any.
 fn start_live_sources(
     config: &Config,
-    inputs: &tokio::sync::mpsc::Sender<Arrived>,
-    stop: &tokio::sync::watch::Receiver<bool>,
-    tasks: &mut tokio::task::JoinSet<()>,
+    inputs: &async_mpsc::Sender<Arrived>,
+    stop: &watch::Receiver<bool>,
+    tasks: &mut JoinSet<()>,
+    events: &Events,
 ) -> Result<bool, RunError> {
     #[cfg_attr(not(any(feature = "can", feature = "shm")), allow(unused_mut))]
     let mut any = false;
     // Each source's counters go to the log (`/ingest/<source>`) at the status interval.
-    let status_interval = std::time::Duration::from_secs_f64(config.outputs.status_interval_s);
-    let stopped = |mut stop: tokio::sync::watch::Receiver<bool>| async move {
+    #[cfg_attr(not(any(feature = "can", feature = "shm")), allow(unused_variables))]
+    let status_interval = Duration::from_secs_f64(config.outputs.status_interval_s);
+    #[cfg_attr(not(any(feature = "can", feature = "shm")), allow(unused_variables))]
+    let stopped = |mut stop: watch::Receiver<bool>| async move {
         let _ = stop.wait_for(|s| *s).await;
     };
     for (interface, map) in can_interfaces(config) {
         #[cfg(feature = "can")]
         {
             any = true;
-            use crate::ingest::can;
+            use crate::sources::can;
             let source = can::open(can::CanSourceConfig {
                 interface: interface.clone(),
                 silence_timeout: SENSOR_TIMEOUT,
@@ -448,13 +457,16 @@ fn start_live_sources(
                 capture: None,
                 capture_frames: 0,
                 stats_interval: Some(status_interval),
-            })
-            .map_err(|e| RunError::Source(e.to_string()))?;
-            let (events_tx, events_rx) = tokio::sync::mpsc::channel(ANALYSIS_QUEUE);
+            })?;
+            let (events_tx, events_rx) = async_mpsc::channel(ANALYSIS_QUEUE);
             let shutdown = stopped(stop.clone());
+            let events = events.clone();
             tasks.spawn(async move {
                 if let Err(e) = source.run(events_tx, shutdown).await {
-                    eprintln!("bearingd: CAN source stopped: {e}");
+                    events(DaemonEvent::SourceStopped {
+                        source: "CAN source".into(),
+                        error: e.to_string(),
+                    });
                 }
             });
             tasks.spawn(forward(
@@ -466,47 +478,76 @@ fn start_live_sources(
         }
         #[cfg(not(feature = "can"))]
         {
-            let _ = (map, inputs, stopped);
-            return Err(RunError::Source(format!(
-                "CAN interface {interface}: this bearingd was built without the `can` feature"
-            )));
+            let _ = (map, inputs, stop, tasks, events);
+            return Err(RunError::NotBuilt {
+                what: format!("CAN interface {interface}"),
+                feature: "can",
+            });
         }
     }
     for (sensor, map) in shm_sensors(config) {
         #[cfg(feature = "shm")]
         {
             any = true;
-            use crate::ingest::{handoff::WhenFull, shm};
+            use crate::sources::{handoff::WhenFull, shm};
             let source = shm::ShmSourceConfig {
                 sensor: sensor.clone(),
-                iox: shm::IoxSettings {
-                    prefix: std::env::var("BEARINGD_IOX_PREFIX").ok(),
-                    root_path: Some(config.outputs.iceoryx2_root.display().to_string()),
-                },
+                iox: crate::iox::IoxSettings::with_root(&config.outputs.iceoryx2_root),
                 silence_timeout: SENSOR_TIMEOUT,
                 handoff_capacity: 64,
                 when_full: WhenFull::DropOldest,
                 stats_interval: Some(status_interval),
             };
-            let (events_tx, events_rx) = tokio::sync::mpsc::channel(ANALYSIS_QUEUE);
+            let (events_tx, events_rx) = async_mpsc::channel(ANALYSIS_QUEUE);
             let shutdown = stopped(stop.clone());
             let name = format!("shm-{sensor}");
+            let events = events.clone();
             tasks.spawn(async move {
                 if let Err(e) = shm::run(source, events_tx, shutdown).await {
-                    eprintln!("bearingd: iceoryx2 source bearingd/accel/{sensor} stopped: {e}");
+                    events(DaemonEvent::SourceStopped {
+                        source: format!("iceoryx2 source {}", crate::iox::sensor_service(&sensor)),
+                        error: e.to_string(),
+                    });
                 }
             });
             tasks.spawn(forward(events_rx, map, name, inputs.clone()));
         }
         #[cfg(not(feature = "shm"))]
         {
-            let _ = (map, inputs, stopped);
-            return Err(RunError::Source(format!(
-                "iceoryx2 sensor {sensor}: this bearingd was built without the `shm` feature"
-            )));
+            let _ = (map, inputs, stop, tasks, events);
+            return Err(RunError::NotBuilt {
+                what: format!("iceoryx2 sensor {sensor}"),
+                feature: "shm",
+            });
         }
     }
     Ok(any)
+}
+
+/// Starts the simulated sensors of the config, if any, as one task.
+fn start_simulated(
+    config: &Config,
+    options: &RunOptions,
+    inputs: &async_mpsc::Sender<Arrived>,
+    stop: &watch::Receiver<bool>,
+    tasks: &mut JoinSet<()>,
+) {
+    let sims: Vec<SimSource> = config
+        .sensors
+        .iter()
+        .filter_map(|sensor| match &sensor.transport {
+            Transport::Sim(sim) => Some(SimSource::new(sensor, sim, SIM_BLOCK_S)),
+            _ => None,
+        })
+        .collect();
+    if !sims.is_empty() {
+        tasks.spawn(feed_simulated(
+            sims,
+            inputs.clone(),
+            options.clone(),
+            stop.clone(),
+        ));
+    }
 }
 
 /// Feeds the simulated sensors' blocks, paced at real time or as fast as the queue takes them,
@@ -514,11 +555,11 @@ fn start_live_sources(
 /// for the shutdown to go on (without it SIGTERM never stopped a run with a simulated sensor).
 async fn feed_simulated(
     mut sims: Vec<SimSource>,
-    tx: tokio::sync::mpsc::Sender<Arrived>,
+    tx: async_mpsc::Sender<Arrived>,
     options: RunOptions,
-    mut stop: tokio::sync::watch::Receiver<bool>,
+    mut stop: watch::Receiver<bool>,
 ) {
-    let mut ticker = tokio::time::interval(std::time::Duration::from_secs_f64(SIM_BLOCK_S));
+    let mut ticker = tokio::time::interval(Duration::from_secs_f64(SIM_BLOCK_S));
     ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     loop {
         if *stop.borrow() {
@@ -539,7 +580,7 @@ async fn feed_simulated(
         }
         let done = options.duration_s.is_some_and(|d| {
             sims.iter()
-                .all(|s| s.next_sample() as f64 >= d * sim_rate(s))
+                .all(|s| s.next_sample() as f64 >= d * s.sample_rate_hz())
         });
         if done || sims.is_empty() {
             return;
@@ -550,145 +591,84 @@ async fn feed_simulated(
     }
 }
 
-fn sim_rate(sim: &SimSource) -> f64 {
-    sim.sample_rate_hz()
+/// Tells systemd the daemon is ready, then waits for the end (every source finished, a
+/// signal, or `--duration` of a live run), reporting status and keeping the watchdog fed;
+/// tells systemd the daemon is stopping.
+#[allow(clippy::too_many_arguments)]
+async fn supervise(
+    config: &Config,
+    options: &RunOptions,
+    live: bool,
+    sources: &mut JoinSet<()>,
+    status: watch::Receiver<Vec<ChannelStatus>>,
+    analysis_queue: async_mpsc::WeakSender<Arrived>,
+    events: &Events,
+    shutdown: impl std::future::Future<Output = ()>,
+) {
+    let interval = Duration::from_secs_f64(config.outputs.status_interval_s);
+    // systemd (Type=notify): ready once the log is open, the threads run and the sources are
+    // started. A no-op without $NOTIFY_SOCKET.
+    let (notifier, problem) = Notifier::from_env();
+    let report = |problem| events(DaemonEvent::Notify(problem));
+    if let Some(problem) = problem {
+        report(problem);
+    }
+    if let Err(problem) = notifier.ready() {
+        report(problem);
+    }
+    let mut progress = status.clone();
+    let supervise = keep_alive(
+        &notifier,
+        interval,
+        || status_text(&status.borrow()),
+        // The watchdog rule: alive if the analysis thread took an input since the last check
+        // (it publishes the status after every input), or if no input waits for it (a silent
+        // sensor is reported as lost, not cured by a restart). Inputs waiting and no progress
+        // for the whole WatchdogSec: no more pings.
+        || {
+            let progressed = progress.has_changed().unwrap_or(false);
+            progress.mark_unchanged();
+            let idle = analysis_queue
+                .upgrade()
+                .is_none_or(|queue| queue.capacity() == queue.max_capacity());
+            progressed || idle
+        },
+        report,
+    );
+    let status_lines = report_status(status.clone(), interval, options.status_lines, events);
+    let live_deadline = async {
+        match options.duration_s.filter(|_| live) {
+            Some(seconds) => tokio::time::sleep(Duration::from_secs_f64(seconds)).await,
+            None => std::future::pending().await,
+        }
+    };
+    tokio::select! {
+        _ = async { while sources.join_next().await.is_some() {} } => {},
+        _ = shutdown => {},
+        _ = live_deadline => {},
+        _ = status_lines => {},
+        _ = supervise => {},
+    }
+    if let Err(problem) = notifier.stopping() {
+        report(problem);
+    }
 }
 
-/// A status line per channel every `interval_s` (never resolves).
-async fn print_status(board: Arc<Mutex<Vec<ChannelStatus>>>, interval_s: f64, enabled: bool) {
+/// Every channel's status every `interval` as [`DaemonEvent::Status`] (never resolves).
+async fn report_status(
+    status: watch::Receiver<Vec<ChannelStatus>>,
+    interval: Duration,
+    enabled: bool,
+    events: &Events,
+) {
     if !enabled {
         return std::future::pending().await;
     }
-    let mut ticker = tokio::time::interval(std::time::Duration::from_secs_f64(interval_s.max(0.1)));
+    let mut ticker = tokio::time::interval(interval.max(Duration::from_millis(100)));
     ticker.tick().await;
     loop {
         ticker.tick().await;
-        let lines: Vec<String> = board
-            .lock()
-            .map(|b| b.iter().map(status_line).collect())
-            .unwrap_or_default();
-        for line in lines {
-            println!("{line}");
-        }
-    }
-}
-
-/// One channel's status in one line.
-pub fn status_line(s: &ChannelStatus) -> String {
-    let band = s.band_hz.map_or("learning".to_string(), |b| {
-        format!("{:.0}-{:.0} Hz", b[0], b[1])
-    });
-    let top = s.top_fault.map_or("-".to_string(), |f| {
-        format!("{} {:.1}", f.name(), s.top_score)
-    });
-    let twin = match (&s.twin_hypothesis, s.twin_error) {
-        (Some(h), Some(e)) => format!("{h} err {e:.3}"),
-        _ => "-".into(),
-    };
-    let flags: Vec<String> = crate::analysis::FaultKind::ALL
-        .iter()
-        .zip(&s.flags)
-        .filter(|(_, l)| l.name() != "ok")
-        .map(|(k, l)| format!("{}={}", k.name(), l.name()))
-        .collect();
-    let rpm = match (s.rpm, s.speed_source) {
-        (Some(rpm), "fixed") => format!("{rpm:.0}"),
-        (Some(rpm), source) => format!("{rpm:.0}({source})"),
-        (None, "estimate") => "?(no estimate yet: scoring waits)".to_string(),
-        (None, _) => "?(no usable speed frame: scoring waits)".to_string(),
-    };
-    format!(
-        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} flags={}{}",
-        s.channel,
-        s.seconds,
-        rpm,
-        band,
-        top,
-        twin,
-        s.stage.name(),
-        if flags.is_empty() {
-            "ok".to_string()
-        } else {
-            flags.join(",")
-        },
-        if s.sensor_lost { " SENSOR LOST" } else { "" }
-    )
-}
-
-/// The one-line `STATUS=` for systemd (`systemctl status`): channel count, then per channel its
-/// sample time, health stage and raised flags; shorter than [`status_line`].
-fn systemd_status(board: &[ChannelStatus]) -> String {
-    let channels: Vec<String> = board
-        .iter()
-        .map(|s| {
-            let flags: Vec<String> = crate::analysis::FaultKind::ALL
-                .iter()
-                .zip(&s.flags)
-                .filter(|(_, l)| l.name() != "ok")
-                .map(|(k, l)| format!("{}={}", k.name(), l.name()))
-                .collect();
-            let flags = if flags.is_empty() {
-                "ok".to_string()
-            } else {
-                flags.join(",")
-            };
-            let lost = if s.sensor_lost { " SENSOR LOST" } else { "" };
-            format!(
-                "{} t={:.1}s {} {flags}{lost}",
-                s.channel,
-                s.seconds,
-                s.stage.name()
-            )
-        })
-        .collect();
-    let plural = if board.len() == 1 { "" } else { "s" };
-    format!("{} channel{plural}; {}", board.len(), channels.join("; "))
-}
-
-/// The MCAP logger's settings from `[outputs]`.
-pub fn logger_config(config: &Config) -> LoggerConfig {
-    let o = &config.outputs;
-    LoggerConfig {
-        max_file_bytes: o.mcap_max_file_bytes(),
-        max_file_duration_ns: (o.mcap_max_file_s * 1e9) as u64,
-        disk_budget_bytes: o.mcap_disk_budget_bytes(),
-        chunk_size: (1u64 << 19).min(o.mcap_max_file_bytes() / 4).max(4096),
-        ..LoggerConfig::new(o.mcap_dir.clone())
-    }
-}
-
-const BASELINES_FILE: &str = "baselines.json";
-
-/// Health baselines kept across restarts; a missing or unreadable file starts afresh (and says so).
-pub fn load_baselines(state_dir: &Path) -> BTreeMap<ChannelId, Baseline> {
-    let path = state_dir.join(BASELINES_FILE);
-    let Ok(text) = std::fs::read_to_string(&path) else {
-        return BTreeMap::new();
-    };
-    match serde_json::from_str::<Vec<(ChannelId, Baseline)>>(&text) {
-        Ok(list) => list.into_iter().collect(),
-        Err(e) => {
-            eprintln!(
-                "bearingd: warning: {}: unreadable ({e}); health baselines are learned again",
-                path.display()
-            );
-            BTreeMap::new()
-        }
-    }
-}
-
-fn save_baselines(state_dir: &Path, baselines: &BTreeMap<ChannelId, Baseline>) {
-    let path = state_dir.join(BASELINES_FILE);
-    let temporary = state_dir.join(format!("{BASELINES_FILE}.new"));
-    let list: Vec<_> = baselines.iter().collect();
-    let written = serde_json::to_string_pretty(&list)
-        .map_err(std::io::Error::other)
-        .and_then(|text| std::fs::write(&temporary, text))
-        .and_then(|_| std::fs::rename(&temporary, &path));
-    if let Err(e) = written {
-        eprintln!(
-            "bearingd: warning: {}: cannot save the health baselines: {e}",
-            path.display()
-        );
+        let board = status.borrow().clone();
+        events(DaemonEvent::Status(board));
     }
 }

@@ -11,7 +11,7 @@ use prost::Message as _;
 use super::error::{McapLogError, Result};
 use super::scan::{ScanOutcome, ScannedRecord, Scanner};
 use super::schema::{JsonKind, RawBlockPb, RAW_BLOCK_SCHEMA};
-use crate::daemon::messages::{PipelineMessage, RawBlock};
+use crate::messages::{PipelineMessage, RawBlock};
 
 /// One message read back, with its MCAP envelope.
 #[derive(Debug, Clone, PartialEq)]

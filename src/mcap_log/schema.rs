@@ -18,7 +18,7 @@ use prost_types::{
 };
 use serde_json::{json, Value};
 
-use crate::daemon::messages::{ChannelId, RawBlock};
+use crate::messages::{ChannelId, PipelineMessage, RawBlock};
 
 /// Schema name (fully qualified protobuf message name) of raw blocks.
 pub const RAW_BLOCK_SCHEMA: &str = "bearingd.RawBlock";
@@ -260,4 +260,56 @@ impl JsonKind {
             "required": required,
         })
     }
+}
+
+/// Serializes `message` into `payload` and its topic into `topic`; returns the JSON kind, or
+/// `None` for raw (protobuf).
+pub fn encode(
+    message: &PipelineMessage,
+    topic: &mut String,
+    payload: &mut Vec<u8>,
+) -> Option<JsonKind> {
+    use std::fmt::Write as _;
+    payload.clear();
+    // Serializing these plain structs into a Vec cannot fail (no maps with non-string keys).
+    let (kind, r) = match message {
+        PipelineMessage::Raw(b) => {
+            let _ = write!(topic, "/raw/{}/{}", b.channel.sensor, b.channel.axis);
+            RawBlockPb::encode_block(b, payload);
+            return None;
+        }
+        PipelineMessage::Spectrum(m) => {
+            let _ = write!(topic, "/spectrum/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Spectrum, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Indicators(m) => {
+            let _ = write!(topic, "/indicators/{}/{}", m.channel.sensor, m.channel.axis);
+            (
+                JsonKind::Indicators,
+                serde_json::to_writer(&mut *payload, m),
+            )
+        }
+        PipelineMessage::Twin(m) => {
+            let _ = write!(topic, "/twin/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Twin, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Flag(m) => {
+            let _ = write!(topic, "/flags/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Flag, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Health(m) => {
+            let _ = write!(topic, "/health/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Health, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Ingest(m) => {
+            let _ = write!(topic, "/ingest/{}", m.source);
+            (JsonKind::Ingest, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Speed(m) => {
+            let _ = write!(topic, "/speed/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Speed, serde_json::to_writer(&mut *payload, m))
+        }
+    };
+    debug_assert!(r.is_ok());
+    Some(kind)
 }

@@ -20,9 +20,6 @@ mod mat;
 mod text;
 mod wav;
 
-#[doc(hidden)]
-pub mod testdata;
-
 use std::fmt;
 use std::path::{Path, PathBuf};
 

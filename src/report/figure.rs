@@ -2,7 +2,8 @@
 //! harmonics marked (tolerance shaded), and the kurtogram with the band that was used.
 
 use super::AnalyzeReport;
-use crate::analysis::{BandSelection, FaultKind, RecordAnalysis};
+use crate::analysis::{BandSelection, RecordAnalysis};
+use crate::messages::FaultKind;
 use crate::plot::{Color, Figure, HeatmapPanel, HeatmapRow, Marker, Series, Shade, SpectrumPanel};
 use crate::twin::diagnose::TwinDiagnosis;
 

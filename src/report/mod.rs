@@ -10,8 +10,9 @@ pub use text::render_text;
 
 use crate::analysis::fault_bands::HarmonicPeak;
 use crate::analysis::indicators::Indicators;
-use crate::analysis::{BandSelection, FaultKind, RecordAnalysis};
+use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::bearing::BearingGeometry;
+use crate::messages::FaultKind;
 use crate::twin::diagnose::{ResidualSummary, TwinDiagnosis};
 use crate::twin::{HypothesisFit, TwinParams};
 use serde::Serialize;

@@ -12,8 +12,9 @@ use crate::analysis::envelope::{
     hop_samples, welch_envelope_spectrum, welch_power_spectrum, window_starts, BandEnvelope,
     FftPlans, WindowTransform,
 };
-use crate::analysis::{Band, FaultKind};
+use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
+use crate::messages::FaultKind;
 use serde::Serialize;
 
 /// What the best twin leaves unexplained.

@@ -21,8 +21,9 @@
 
 use super::model::{EnvelopeModel, ShapeParams};
 use super::optimize::{golden_section, nelder_mead};
-use crate::analysis::{Band, FaultKind};
+use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
+use crate::messages::FaultKind;
 use serde::Serialize;
 
 /// The fault hypotheses a twin can have.

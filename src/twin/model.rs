@@ -25,8 +25,9 @@
 //! So the twin's power spectrum is `a⁴·U(f; f_d, B, f_n, σ) + c·N(f)`: linear in `a⁴` and the
 //! noise level `c`, non-linear in the rest. [`EnvelopeModel::basis`] computes `U` and `N`.
 
-use crate::analysis::{Band, FaultKind};
+use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
+use crate::messages::FaultKind;
 use rustfft::num_complex::Complex64;
 use std::f64::consts::{PI, TAU};
 

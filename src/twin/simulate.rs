@@ -9,8 +9,8 @@
 //! deterministic for a given seed.
 
 use super::rng::Rng;
-use crate::analysis::FaultKind;
 use crate::bearing::{BearingGeometry, FaultFrequencies};
+use crate::messages::FaultKind;
 use serde::Serialize;
 
 /// Which defect the simulated bearing has.
@@ -67,6 +67,10 @@ pub struct SimulationParams {
 
 impl SimulationParams {
     /// A typical CWRU-like outer-race case: SKF 6205-2RS at 1772 rpm, 12 kHz, resonance 3 kHz.
+    #[allow(
+        clippy::expect_used,
+        reason = "a catalog entry; the catalog tests check it exists"
+    )]
     pub fn example(fault: SimulatedFault) -> Self {
         SimulationParams {
             fault,

@@ -2,7 +2,7 @@
 //! Python example (`examples/alerts_subscriber.py`, the `iceoryx2` package from PyPI)
 //! subscribe.
 
-use bearingd::recording::testdata::{python_iceoryx2, scratch_dir};
+use bearingd_testdata::{python_iceoryx2, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};

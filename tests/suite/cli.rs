@@ -1,7 +1,7 @@
 //! The `bearingd` binary as a user meets it: outputs, pictures, and one-line errors with exit
 //! code 2 for every kind of bad input.
 
-use bearingd::recording::testdata::{scratch_dir, shared_data_dir};
+use bearingd_testdata::{scratch_dir, shared_data_dir};
 use std::path::Path;
 use std::process::{Command, Output};
 

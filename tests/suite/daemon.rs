@@ -2,9 +2,9 @@
 //! log is read by Python's strict reader, a replay raises the same flags at the same samples,
 //! a `kill -9` loses at most the open chunk, and a bad config refuses to start.
 
-use bearingd::daemon::messages::PipelineMessage;
 use bearingd::mcap_log::read_messages;
-use bearingd::recording::testdata::{check_mcap_with_python, python_mcap, scratch_dir};
+use bearingd::messages::PipelineMessage;
+use bearingd_testdata::{check_mcap_with_python, python_mcap, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -32,9 +32,13 @@ fn mcap_files(dir: &Path) -> Vec<PathBuf> {
 fn logged_flags(files: &[PathBuf]) -> Vec<(String, String, String, String, u64)> {
     read_messages(files)
         .filter_map(|m| match m.expect("readable log").message {
-            PipelineMessage::Flag(f) => {
-                Some((f.channel.to_string(), f.fault, f.from, f.to, f.end_sample))
-            }
+            PipelineMessage::Flag(f) => Some((
+                f.channel.to_string(),
+                f.fault.to_string(),
+                f.from.to_string(),
+                f.to.to_string(),
+                f.end_sample,
+            )),
             _ => None,
         })
         .collect()
@@ -378,12 +382,12 @@ iceoryx2_root = "{iox}"
 /// and no other; no record raises a flag of a wrong fault.
 #[test]
 fn imported_cwru_records_replayed_raise_the_right_flags() {
-    let Some(data) = bearingd::recording::testdata::shared_data_dir("cwru") else {
+    let Some(data) = bearingd_testdata::shared_data_dir("cwru") else {
         return;
     };
     let dir = scratch_dir("daemon-import");
     let mut problems = Vec::new();
-    for row in bearingd::recording::testdata::read_manifest(&data) {
+    for row in bearingd_testdata::read_manifest(&data) {
         let out = dir.join(row["file"].replace(['@', '.'], "_"));
         let imported = bearingd(&[
             "import",

@@ -8,8 +8,8 @@
 
 use bearingd::analysis::record::RecordAnalyzer;
 use bearingd::offline::{analyze, AnalyzeRequest};
-use bearingd::recording::testdata::{read_manifest, shared_data_dir};
 use bearingd::recording::ReadOptions;
+use bearingd_testdata::{read_manifest, shared_data_dir};
 
 fn expected_class(fault: &str) -> &'static str {
     match fault {

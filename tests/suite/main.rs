@@ -1,5 +1,6 @@
 //! The integration-test suite: one binary, one module per part (ripgrep's layout), so that the
 //! suite links once.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod alerts;
 mod cli;

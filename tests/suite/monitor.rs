@@ -2,10 +2,10 @@
 //! raises exactly that flag, after the onset, and the same samples cut into other blocks give
 //! exactly the same events at the same samples.
 
-use bearingd::analysis::flags::{FlagLevel, FlagSettings};
-use bearingd::analysis::health::HealthStage;
+use bearingd::analysis::flags::FlagSettings;
 use bearingd::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings, SpeedMode};
 use bearingd::analysis::AnalysisSettings;
+use bearingd::messages::{FlagLevel, HealthKind, HealthStage};
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 
 const SCALE: f64 = 0.000_488;
@@ -107,7 +107,7 @@ fn describe(event: MonitorEvent, events: &mut Vec<String>) {
             at_sample,
         } => events.push(format!(
             "sensor {} {active} at {at_sample}",
-            condition.name()
+            HealthKind::from(condition).name()
         )),
         MonitorEvent::Gap { at_sample, missing } => {
             events.push(format!("gap {missing} at {at_sample}"))

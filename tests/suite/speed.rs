@@ -7,9 +7,9 @@ use bearingd::analysis::record::RecordAnalyzer;
 use bearingd::analysis::speed::{estimate_shaft_hz, SpeedSearch};
 use bearingd::analysis::{AnalysisSettings, Verdict};
 use bearingd::bearing::BearingGeometry;
-use bearingd::recording::testdata::{read_manifest, shared_data_dir};
 use bearingd::recording::{read_recording, ReadOptions};
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
+use bearingd_testdata::{read_manifest, shared_data_dir};
 
 /// CWRU record 234 (outer race 0.021 in, 0 hp, 1796 rpm measured): its diagnosis is `none`,
 /// not outer race, for any speed from 1795.2 to 1795.5 rpm (the inner-race score of one band

@@ -2,11 +2,12 @@
 //! and on real CWRU records the right hypothesis wins with a small envelope-spectrum error.
 
 use bearingd::analysis::envelope::FftPlans;
-use bearingd::analysis::{Band, FaultKind};
+use bearingd::analysis::Band;
+use bearingd::messages::FaultKind;
 use bearingd::offline::{analyze, AnalyzeRequest};
-use bearingd::recording::testdata::{read_manifest, shared_data_dir};
 use bearingd::twin::diagnose::fit_record;
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator, TwinFitter};
+use bearingd_testdata::{read_manifest, shared_data_dir};
 
 #[test]
 fn simulation_is_deterministic_and_blockwise_equals_one_shot() {

@@ -9,6 +9,7 @@
 //! ```sh
 //! BEARING_WIRE_BLESS=1 cargo test -p bearing-wire --test dbc
 //! ```
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 

@@ -1,5 +1,6 @@
 //! SensorNode: long runs pack every sample exactly once with contiguous indices; metadata comes
 //! on schedule; overflow, reset and flush are counted, never silent.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 

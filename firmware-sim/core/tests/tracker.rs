@@ -1,6 +1,7 @@
 //! SequenceTracker: in order, gaps, duplicates, old frames, restarts, wraparound of both
 //! layouts' counters, and an end-to-end run node → bytes → tracker where every lost sample is
 //! accounted for.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
 

@@ -334,7 +334,7 @@ fn open_transport(args: &Args) -> Result<Box<dyn Transport>, SimError> {
         TransportKind::Shm => {
             #[cfg(feature = "shm")]
             {
-                let iox = bearingd::ingest::shm::IoxSettings {
+                let iox = bearing_iox::IoxSettings {
                     prefix: args.iox_prefix.clone(),
                     root_path: args.iox_root.clone(),
                 };

@@ -115,9 +115,9 @@ pub mod can {
 pub mod shm {
     use super::Transport;
     use crate::SimError;
-    use bearingd::ingest::payload::{FrameBatch, WireFrame};
-    use bearingd::ingest::shm::{
-        backpressure, create_node, open_data_service, open_event_service, IoxSettings, ServiceNames,
+    use bearing_iox::{
+        backpressure, create_node, open_data_service, open_event_service, FrameBatch, IoxSettings,
+        ServiceNames, ShmError, WireFrame,
     };
     use iceoryx2::prelude::*;
     use std::time::{Duration, Instant};
@@ -142,7 +142,7 @@ pub mod shm {
             block: bool,
         ) -> Result<ShmTransport, SimError> {
             let names = ServiceNames::for_sensor(sensor);
-            let shm = |e: bearingd::ingest::shm::ShmError| SimError::Shm(e.to_string());
+            let shm = |e: ShmError| SimError::Shm(e.to_string());
             let node = create_node(iox).map_err(shm)?;
             let data = open_data_service(&node, &names).map_err(shm)?;
             let publisher = data

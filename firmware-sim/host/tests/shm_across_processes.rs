@@ -1,10 +1,12 @@
 //! iceoryx2 across real processes: the `firmware-sim` binary publishes, this test process
 //! subscribes through bearingd's shm source. Ready handshake first, then zero loss over more
 //! than a million samples per stream, with every sample checked against the twin.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
-use bearingd::ingest::handoff::WhenFull;
-use bearingd::ingest::shm::{self, IoxSettings, ShmSourceConfig};
-use bearingd::ingest::IngestEvent;
+use bearingd::iox::IoxSettings;
+use bearingd::sources::handoff::WhenFull;
+use bearingd::sources::shm::{self, ShmSourceConfig};
+use bearingd::sources::IngestEvent;
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 use std::collections::BTreeMap;
 use std::process::{Command, Stdio};

@@ -1,10 +1,19 @@
-//! The MCAP log as a sink of the daemon: maps sample time to log time, flushes the open chunk
-//! every second of data (a crash loses at most that), recovers unfinished files at start, and
-//! finishes the file at shutdown.
+//! The MCAP log as a sink: the writer with rotation and a disk budget ([`writer`]), the
+//! start-up recovery of files a crash left unfinished ([`recover`]), and [`McapSink`], which
+//! maps sample time to log time, flushes the open chunk every second of data (a crash loses at
+//! most that), recovers unfinished files at start, and finishes the file at shutdown. The
+//! format itself (schemas, topics, file names, reading back) is [`crate::mcap_log`].
 
-use super::messages::PipelineMessage;
-use super::run::Sink;
-use crate::mcap_log::{recover_directory, LoggerConfig, McapLogError, McapLogger, RecoveryReport};
+pub mod recover;
+pub mod writer;
+
+pub use recover::{is_finished, recover_directory, recover_file, RecoveryReport};
+pub use writer::{enforce_budget, LogStats, LoggerConfig, McapLogger, RetentionReport, TopicStats};
+
+use crate::config::Config;
+use crate::mcap_log::McapLogError;
+use crate::messages::PipelineMessage;
+use crate::pipeline::{Sink, SinkError};
 use std::collections::HashMap;
 use std::path::Path;
 
@@ -52,6 +61,15 @@ impl McapSink {
         ))
     }
 
+    /// [`open`](Self::open) with the log settings of `config`'s `[outputs]` and its sensors'
+    /// sample rates.
+    pub fn for_config(
+        config: &Config,
+        origin_ns: u64,
+    ) -> Result<(Self, Vec<RecoveryReport>), McapLogError> {
+        McapSink::open(logger_config(config), config.sample_rates(), origin_ns)
+    }
+
     pub fn current_path(&self) -> Option<&Path> {
         self.logger.as_ref().and_then(|l| l.current_path())
     }
@@ -94,17 +112,30 @@ impl Sink for McapSink {
         }
     }
 
-    fn finish(&mut self) -> Result<(), String> {
+    fn finish(&mut self) -> Result<(), SinkError> {
         let finished = self.logger.take().map(|l| l.finish());
         if let Some(Err(e)) = finished {
             self.errors.push(e.to_string());
         }
         match self.errors.first() {
             None => Ok(()),
-            Some(first) => Err(format!(
-                "MCAP log: {} error(s), the first: {first}",
-                self.errors.len()
-            )),
+            Some(first) => Err(SinkError {
+                sink: "MCAP log",
+                count: self.errors.len(),
+                first: first.clone(),
+            }),
         }
+    }
+}
+
+/// The MCAP logger's settings from `[outputs]`.
+pub fn logger_config(config: &Config) -> LoggerConfig {
+    let o = &config.outputs;
+    LoggerConfig {
+        max_file_bytes: o.mcap_max_file_bytes(),
+        max_file_duration_ns: (o.mcap_max_file_s * 1e9) as u64,
+        disk_budget_bytes: o.mcap_disk_budget_bytes(),
+        chunk_size: (1u64 << 19).min(o.mcap_max_file_bytes() / 4).max(4096),
+        ..LoggerConfig::new(o.mcap_dir.clone())
     }
 }

@@ -7,9 +7,8 @@
 //! integer codes listed here and in `docs/ALERTS.md`. The fields are ordered from the widest
 //! to the narrowest so there is no padding to get wrong.
 
-use crate::analysis::fault_bands::FaultKind;
-use crate::analysis::flags::FlagLevel;
 use crate::config::MAX_ID_LEN;
+use crate::messages::{FaultKind, FlagLevel};
 #[cfg(feature = "shm")]
 use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;

@@ -12,12 +12,9 @@
 
 use super::payload::{fault_code, name_field, severity_code, Alert, AlertState, ALERT_VERSION};
 use crate::analysis::diagnosis::score_evidence;
-use crate::analysis::fault_bands::FaultKind;
-use crate::analysis::flags::FlagLevel;
 use crate::analysis::AnalysisSettings;
-use crate::daemon::messages::{
-    ChannelId, FlagMessage, IndicatorsMessage, PipelineMessage, TwinMessage,
-};
+use crate::messages::{ChannelId, FlagMessage, IndicatorsMessage, PipelineMessage, TwinMessage};
+use crate::messages::{FaultKind, FlagLevel};
 use crate::twin::diagnose::twin_adjusted_confidence;
 use std::collections::{BTreeMap, HashMap};
 
@@ -123,7 +120,7 @@ impl AlertTracker {
         self.twins.insert(
             m.channel.clone(),
             TwinSummary {
-                best: FaultKind::from_name(&m.hypothesis),
+                best: Some(m.hypothesis),
                 margin: m.margin,
                 errors: [
                     m.error_outer_race,
@@ -136,11 +133,9 @@ impl AlertTracker {
     }
 
     fn alert_for(&self, flag: &FlagMessage, wall_time_ns: u64) -> Option<(AlertKey, Alert)> {
-        let fault = FaultKind::from_name(&flag.fault)?;
-        let from = FlagLevel::from_name(&flag.from)?;
-        let to = FlagLevel::from_name(&flag.to)?;
+        let (fault, from, to) = (flag.fault, flag.from, flag.to);
         let state = AlertState::of_change(from, to);
-        let index = FaultKind::ALL.iter().position(|f| *f == fault)?;
+        let index = fault.index();
         let runner_up = self.scores.get(&flag.channel).map_or(1.0, |scores| {
             scores
                 .iter()
@@ -233,18 +228,27 @@ impl AlertTracker {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::alerts::payload::AlertState;
+    use crate::sinks::alerts::payload::AlertState;
+    use FaultKind::{Ball, InnerRace, OuterRace};
+    use FlagLevel::{Alarm, Watch};
+    const OK: FlagLevel = FlagLevel::Ok;
 
-    fn flag(axis: &str, fault: &str, from: &str, to: &str, at: u64) -> PipelineMessage {
+    fn flag(
+        axis: &str,
+        fault: FaultKind,
+        from: FlagLevel,
+        to: FlagLevel,
+        at: u64,
+    ) -> PipelineMessage {
         PipelineMessage::Flag(FlagMessage {
             channel: ChannelId {
                 sensor: "motor-de".into(),
                 axis: axis.into(),
             },
             end_sample: at,
-            fault: fault.into(),
-            from: from.into(),
-            to: to.into(),
+            fault,
+            from,
+            to,
             score: 40.0,
             fault_frequency_hz: 107.0,
         })
@@ -265,27 +269,27 @@ mod tests {
     fn a_flag_cycle_gives_raised_escalated_relaxed_cleared_in_sequence() {
         let mut t = tracker(16);
         let steps = [
-            ("ok", "watch", AlertState::Raised),
-            ("watch", "alarm", AlertState::Escalated),
-            ("alarm", "watch", AlertState::Relaxed),
-            ("watch", "ok", AlertState::Cleared),
+            (OK, Watch, AlertState::Raised),
+            (Watch, Alarm, AlertState::Escalated),
+            (Alarm, Watch, AlertState::Relaxed),
+            (Watch, OK, AlertState::Cleared),
         ];
         for (j, (from, to, state)) in steps.into_iter().enumerate() {
             let alerts = observe(
                 &mut t,
-                &flag("radial", "outer_race", from, to, 1000 * j as u64),
+                &flag("radial", OuterRace, from, to, 1000 * j as u64),
             );
             assert_eq!(alerts.len(), 1);
             let view = alerts[0].view().unwrap();
             assert_eq!(view.state, state);
             assert_eq!(view.sequence, j as u64 + 1);
             assert_eq!(view.run_id, 99);
-            assert_eq!(view.severity, to);
-            assert_eq!(view.previous_severity, from);
+            assert_eq!(view.severity, to.name());
+            assert_eq!(view.previous_severity, from.name());
             assert_eq!(view.fault, "outer_race");
             assert_eq!(view.axis, "radial");
             let active = t.active().count();
-            assert_eq!(active, usize::from(to != "ok"));
+            assert_eq!(active, usize::from(to != OK));
         }
     }
 
@@ -309,10 +313,10 @@ mod tests {
             score_ball: 4.0,
             score_cage: 2.0,
         });
-        let twin = |hypothesis: &str| TwinMessage {
+        let twin = |hypothesis: FaultKind| TwinMessage {
             channel: channel.clone(),
             end_sample: 0,
-            hypothesis: hypothesis.into(),
+            hypothesis,
             error: 0.2,
             margin: 0.2,
             error_outer_race: 0.2,
@@ -328,7 +332,7 @@ mod tests {
             residual_bin_hz: 1.0,
             residual: vec![],
         };
-        let raise = flag("radial", "outer_race", "ok", "watch", 10);
+        let raise = flag("radial", OuterRace, OK, Watch, 10);
         let mut plain = tracker(16);
         observe(&mut plain, &scores);
         let base = observe(&mut plain, &raise)[0];
@@ -337,14 +341,14 @@ mod tests {
 
         let mut agreeing = tracker(16);
         observe(&mut agreeing, &scores);
-        agreeing.note_twin(&twin("outer_race"));
+        agreeing.note_twin(&twin(OuterRace));
         let up = observe(&mut agreeing, &raise)[0];
         assert!(up.confidence > base.confidence);
         assert_eq!(up.twin_error, 0.2);
 
         let mut disagreeing = tracker(16);
         observe(&mut disagreeing, &scores);
-        disagreeing.note_twin(&twin("inner_race"));
+        disagreeing.note_twin(&twin(InnerRace));
         let down = observe(&mut disagreeing, &raise)[0];
         assert!(down.confidence < base.confidence);
     }
@@ -353,15 +357,11 @@ mod tests {
     fn an_old_active_alert_is_repeated_before_it_leaves_the_history() {
         let history = 16;
         let mut t = tracker(history);
-        let mut all = observe(&mut t, &flag("x", "outer_race", "ok", "watch", 1));
+        let mut all = observe(&mut t, &flag("x", OuterRace, OK, Watch, 1));
         // Another axis flaps for a long time.
         for j in 0..40u64 {
-            let (from, to) = if j % 2 == 0 {
-                ("ok", "watch")
-            } else {
-                ("watch", "ok")
-            };
-            all.extend(observe(&mut t, &flag("y", "ball", from, to, 100 + j)));
+            let (from, to) = if j % 2 == 0 { (OK, Watch) } else { (Watch, OK) };
+            all.extend(observe(&mut t, &flag("y", Ball, from, to, 100 + j)));
         }
         let sequences: Vec<u64> = all.iter().map(|a| a.sequence).collect();
         assert_eq!(sequences, (1..=all.len() as u64).collect::<Vec<_>>());

@@ -1,4 +1,5 @@
-//! Test helpers shared by unit and integration tests (hidden; not part of the product API).
+//! Test helpers shared by bearingd's unit and integration tests: a dev-dependency only, so none
+//! of it compiles into the daemon.
 //!
 //! The real data sets live outside the repository (`../shared/data`, never committed), so a test
 //! that needs one must say loudly when it is missing, and must fail on CI where a silent skip
@@ -9,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The directory of one shared data set (`cwru`, `femto`, `ims`): under `$BEARINGD_DATA_DIR`
-/// if set, else `CARGO_MANIFEST_DIR/../shared/data`.
+/// if set, else `<repository>/../shared/data`.
 ///
 /// When it is missing: with `CI=true` this panics (the test fails) naming the data set and
 /// where it was looked for; otherwise it prints a loud notice (past the test harness's capture) and returns `None` so the test
@@ -18,8 +19,8 @@ pub fn shared_data_dir(kind: &str) -> Option<PathBuf> {
     let (base, source) = match std::env::var_os("BEARINGD_DATA_DIR") {
         Some(dir) => (PathBuf::from(dir), "$BEARINGD_DATA_DIR"),
         None => (
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-            "the default CARGO_MANIFEST_DIR/../shared/data",
+            repo_root().join("../shared/data"),
+            "the default <repository>/../shared/data",
         ),
     };
     let dir = base.join(kind);
@@ -41,6 +42,11 @@ pub fn shared_data_dir(kind: &str) -> Option<PathBuf> {
         "\n**********\nSKIPPING: {message}\n**********\n"
     );
     None
+}
+
+/// The root of the bearingd repository (this crate lives in `crates/bearingd-testdata`).
+fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 
 /// A fresh, empty scratch directory under the system temp dir, unique per process and call.
@@ -105,7 +111,7 @@ pub fn python_iceoryx2() -> Option<PathBuf> {
 }
 
 fn venv_python(imports: &str, what: &str) -> Option<PathBuf> {
-    let py = Path::new(env!("CARGO_MANIFEST_DIR")).join(".venv/bin/python");
+    let py = repo_root().join(".venv/bin/python");
     let ci = std::env::var("CI").is_ok_and(|v| v == "true");
     let problem = if !py.exists() {
         Some(format!("{} does not exist", py.display()))
@@ -138,7 +144,7 @@ pub fn check_mcap_with_python(
     file: &Path,
     expected: Option<&Path>,
 ) -> serde_json::Value {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/check_mcap.py");
+    let script = repo_root().join("tests/python/check_mcap.py");
     let mut cmd = std::process::Command::new(py);
     cmd.arg(script).arg(file);
     if let Some(e) = expected {

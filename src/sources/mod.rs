@@ -1,4 +1,10 @@
-//! Sources: sensor frames from a transport, turned into sample blocks in sample time.
+//! Sources: everything that turns sensor data into the pipeline's inputs, in sample time.
+//!
+//! - [`can`] (feature `can`), [`shm`] (feature `shm`): the transports; [`live`] maps their
+//!   events onto the config's channels for `bearingd run`.
+//! - [`sim`]: the in-process simulated sensor node (the twin's signal model).
+//! - [`replay`]: the raw samples and measured speeds of MCAP logs.
+//! - [`Arrived`] and [`wall_clock_now_ns`]: the one wall-clock reading on the way in.
 //!
 //! Why this module exists apart from the analysis core: the core is sans-IO (no socket, no
 //! clock, no async runtime), so something must own the sockets, the shared memory, the
@@ -7,11 +13,13 @@
 //! crate and reports [`IngestEvent`]s (samples, gaps, restarts, sensor lost/back, speed,
 //! metadata, malformed frames) and [`IngestStats`].
 //!
+//! The transports:
+//!
 //! - [`can`] (feature `can`): SocketCAN (classic and FD) on tokio.
 //! - [`shm`] (feature `shm`): iceoryx2 publish-subscribe `bearingd/accel/<sensor>`, on its own
 //!   thread (iceoryx2 ports are not `Send`), woken by an iceoryx2 event, handing batches to
 //!   the async side through a bounded [`handoff`] queue.
-//! - [`payload`]: the iceoryx2 payload (`FrameBatch` of CAN-shaped frames).
+//!   The payload (`FrameBatch` of CAN-shaped frames) is [`crate::iox`]'s.
 //!
 //! Queue policies (every drop is counted): frames lost before the assembler (a full socket
 //! buffer, a full hand-off queue) reappear as exact sequence gaps; the event channel after the
@@ -23,13 +31,16 @@ pub mod assemble;
 #[cfg(feature = "can")]
 pub mod can;
 pub mod handoff;
-pub mod payload;
+pub mod live;
+pub mod replay;
 #[cfg(feature = "shm")]
 pub mod shm;
+pub mod sim;
 
 pub use assemble::{
     Assembler, IngestEvent, IngestStats, MalformedCounts, MalformedKind, SampleBlock, StreamSummary,
 };
+pub use live::Arrived;
 
 use std::collections::BTreeMap;
 use std::time::Duration;
@@ -112,4 +123,14 @@ impl StatsTimer {
             None => std::future::pending().await,
         }
     }
+}
+
+/// The system clock in nanoseconds since the Unix epoch, for the edges of the daemon (an
+/// input's arrival, the log's origin, an alert's run id); never called by the analysis, the
+/// pipeline or the log writer.
+pub fn wall_clock_now_ns() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
+        .unwrap_or(0)
 }

@@ -9,8 +9,7 @@
 //!
 //! Time: the logger never reads a clock. The caller passes the opening time and every
 //! message's `log_time`/`publish_time` (nanoseconds since the Unix epoch; the daemon maps sample
-//! time to wall time). [`wall_clock_now_ns`] is the one helper that reads the system clock, for
-//! the daemon's edge only, so that tests stay deterministic.
+//! time to wall time), so that tests stay deterministic.
 
 use std::collections::{BTreeMap, HashMap};
 use std::fs::{File, OpenOptions};
@@ -22,14 +21,10 @@ use std::sync::Arc;
 use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions};
 
-use super::error::{io_err, McapLogError, Result};
-use super::schema::{self, JsonKind, RawBlockPb, RAW_BLOCK_SCHEMA};
-use crate::daemon::messages::PipelineMessage;
-
-/// File name prefix of every log file; retention only ever touches `bearingd-*.mcap`.
-pub const FILE_PREFIX: &str = "bearingd-";
-/// File name suffix.
-pub const FILE_SUFFIX: &str = ".mcap";
+use crate::mcap_log::error::{io_err, McapLogError, Result};
+use crate::mcap_log::files::{file_name, is_log_file_name};
+use crate::mcap_log::schema::{self, encode, JsonKind, RAW_BLOCK_SCHEMA};
+use crate::messages::PipelineMessage;
 
 /// Where and how to log.
 #[derive(Debug, Clone, PartialEq)]
@@ -125,49 +120,6 @@ pub struct RetentionReport {
     pub bytes_deleted: u64,
     /// Bytes of `bearingd-*.mcap` files left in the directory, the open file included.
     pub total_bytes_after: u64,
-}
-
-/// The system clock in nanoseconds since the Unix epoch: the only place this module reads a
-/// clock, for the daemon to call at its edge (never from analysis or from the logger itself).
-pub fn wall_clock_now_ns() -> u64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
-        .unwrap_or(0)
-}
-
-/// `bearingd-YYYYMMDDTHHMMSSZ-NNNNNN.mcap` for a UTC time in ns since the epoch: fixed width,
-/// so sorting names sorts files by opening time, then sequence.
-pub fn file_name(opened_at_ns: u64, seq: u32) -> String {
-    let secs = opened_at_ns / 1_000_000_000;
-    let days = (secs / 86_400) as i64;
-    let rem = secs % 86_400;
-    let (y, m, d) = civil_from_days(days);
-    format!(
-        "{FILE_PREFIX}{y:04}{m:02}{d:02}T{:02}{:02}{:02}Z-{seq:06}{FILE_SUFFIX}",
-        rem / 3600,
-        (rem / 60) % 60,
-        rem % 60
-    )
-}
-
-/// Gregorian date of a day count since 1970-01-01 (the well-known era/day-of-era method).
-fn civil_from_days(z: i64) -> (i64, u32, u32) {
-    let z = z + 719_468;
-    let era = z.div_euclid(146_097);
-    let doe = z.rem_euclid(146_097);
-    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
-    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-    let mp = (5 * doy + 2) / 153;
-    let d = (doy - (153 * mp + 2) / 5 + 1) as u32;
-    let m = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
-    let y = yoe + era * 400 + i64::from(m <= 2);
-    (y, m, d)
-}
-
-/// Is this a log file name this module wrote (and so may delete)?
-pub fn is_log_file_name(name: &str) -> bool {
-    name.starts_with(FILE_PREFIX) && name.ends_with(FILE_SUFFIX)
 }
 
 /// Tracks the logical position and length of a seekable stream, so the open file's size is
@@ -547,56 +499,4 @@ pub fn enforce_budget(dir: &Path, budget: u64, open: Option<&Path>) -> Result<Re
     }
     report.total_bytes_after = total;
     Ok(report)
-}
-
-/// Serializes `message` into `payload` and its topic into `topic`; returns the JSON kind, or
-/// `None` for raw (protobuf).
-fn encode(
-    message: &PipelineMessage,
-    topic: &mut String,
-    payload: &mut Vec<u8>,
-) -> Option<JsonKind> {
-    use std::fmt::Write as _;
-    payload.clear();
-    // Serializing these plain structs into a Vec cannot fail (no maps with non-string keys).
-    let (kind, r) = match message {
-        PipelineMessage::Raw(b) => {
-            let _ = write!(topic, "/raw/{}/{}", b.channel.sensor, b.channel.axis);
-            RawBlockPb::encode_block(b, payload);
-            return None;
-        }
-        PipelineMessage::Spectrum(m) => {
-            let _ = write!(topic, "/spectrum/{}/{}", m.channel.sensor, m.channel.axis);
-            (JsonKind::Spectrum, serde_json::to_writer(&mut *payload, m))
-        }
-        PipelineMessage::Indicators(m) => {
-            let _ = write!(topic, "/indicators/{}/{}", m.channel.sensor, m.channel.axis);
-            (
-                JsonKind::Indicators,
-                serde_json::to_writer(&mut *payload, m),
-            )
-        }
-        PipelineMessage::Twin(m) => {
-            let _ = write!(topic, "/twin/{}/{}", m.channel.sensor, m.channel.axis);
-            (JsonKind::Twin, serde_json::to_writer(&mut *payload, m))
-        }
-        PipelineMessage::Flag(m) => {
-            let _ = write!(topic, "/flags/{}/{}", m.channel.sensor, m.channel.axis);
-            (JsonKind::Flag, serde_json::to_writer(&mut *payload, m))
-        }
-        PipelineMessage::Health(m) => {
-            let _ = write!(topic, "/health/{}/{}", m.channel.sensor, m.channel.axis);
-            (JsonKind::Health, serde_json::to_writer(&mut *payload, m))
-        }
-        PipelineMessage::Ingest(m) => {
-            let _ = write!(topic, "/ingest/{}", m.source);
-            (JsonKind::Ingest, serde_json::to_writer(&mut *payload, m))
-        }
-        PipelineMessage::Speed(m) => {
-            let _ = write!(topic, "/speed/{}/{}", m.channel.sensor, m.channel.axis);
-            (JsonKind::Speed, serde_json::to_writer(&mut *payload, m))
-        }
-    };
-    debug_assert!(r.is_ok());
-    Some(kind)
 }

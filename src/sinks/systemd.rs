@@ -10,15 +10,30 @@
 //! - Without `$NOTIFY_SOCKET` every call is a no-op, so `bearingd run` in a terminal, in tests
 //!   and under other supervisors behaves exactly as before.
 //! - Notification never stops or slows the daemon: the socket is non-blocking, and the first
-//!   failure is written once to stderr (the journal), later ones are only counted.
+//!   failure is returned once (the daemon reports it in the journal), later ones are only
+//!   counted.
 //! - The watchdog interval comes from `$WATCHDOG_USEC`; when `$WATCHDOG_PID` is set it must be
 //!   our pid (the variables may have been inherited from a parent that is supervised itself).
 //! - [`keep_alive`] pings the watchdog only while the caller says the pipeline is alive; the
-//!   rule for "alive" belongs to the caller (see `run.rs`), the timing belongs here.
+//!   rule for "alive" belongs to the caller (see `daemon/run.rs`), the timing belongs here.
+//! - [`status_text`]: the one-line `STATUS=` shown by `systemctl status`.
 
+use crate::pipeline::ChannelStatus;
 use std::os::unix::net::{SocketAddr, UnixDatagram};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
+
+/// Why a notification could not be sent (reported once; the daemon goes on without).
+#[derive(Debug, thiserror::Error)]
+pub enum NotifyError {
+    #[error("NOTIFY_SOCKET={socket}: cannot use it ({source}); no systemd notifications")]
+    Socket {
+        socket: String,
+        source: std::io::Error,
+    },
+    #[error("cannot notify systemd ({0}); the daemon goes on, later failures are not reported")]
+    Send(std::io::Error),
+}
 
 /// Where notifications go, if anywhere, and the watchdog interval systemd asked for.
 #[derive(Debug)]
@@ -32,8 +47,8 @@ pub struct Notifier {
 
 impl Notifier {
     /// The notifier systemd set up for this process through its environment; a no-op one when
-    /// `$NOTIFY_SOCKET` is unset or unusable (the reason is written to stderr).
-    pub fn from_env() -> Notifier {
+    /// `$NOTIFY_SOCKET` is unset or unusable (then with the reason).
+    pub fn from_env() -> (Notifier, Option<NotifyError>) {
         let socket = std::env::var_os("NOTIFY_SOCKET");
         let usec = std::env::var("WATCHDOG_USEC").ok();
         let pid = std::env::var("WATCHDOG_PID").ok();
@@ -46,21 +61,23 @@ impl Notifier {
     }
 
     /// A notifier from the three variables' values and our pid (separate from the environment
-    /// so tests need not mutate it).
+    /// so tests need not mutate it); with the reason when the socket is set but unusable.
     pub fn from_parts(
         notify_socket: Option<&str>,
         watchdog_usec: Option<&str>,
         watchdog_pid: Option<&str>,
         our_pid: u32,
-    ) -> Notifier {
+    ) -> (Notifier, Option<NotifyError>) {
+        let mut problem = None;
         let target = notify_socket
             .filter(|s| !s.is_empty())
             .and_then(|s| match open(s) {
                 Ok(target) => Some(target),
-                Err(e) => {
-                    eprintln!(
-                        "bearingd: NOTIFY_SOCKET={s}: cannot use it ({e}); no systemd notifications"
-                    );
+                Err(source) => {
+                    problem = Some(NotifyError::Socket {
+                        socket: s.to_string(),
+                        source,
+                    });
                     None
                 }
             });
@@ -69,17 +86,18 @@ impl Notifier {
             .and_then(|u| u.trim().parse::<u64>().ok())
             .filter(|&u| u > 0 && for_us)
             .map(Duration::from_micros);
-        Notifier {
+        let notifier = Notifier {
             target,
             watchdog,
             warned: AtomicBool::new(false),
             failures: AtomicU64::new(0),
-        }
+        };
+        (notifier, problem)
     }
 
     /// A notifier that sends nothing.
     pub fn disabled() -> Notifier {
-        Notifier::from_parts(None, None, None, 0)
+        Notifier::from_parts(None, None, None, 0).0
     }
 
     /// Whether notifications go anywhere.
@@ -93,28 +111,28 @@ impl Notifier {
     }
 
     /// Start-up is complete: `Type=notify` units become active now.
-    pub fn ready(&self) {
-        self.send("READY=1");
+    pub fn ready(&self) -> Result<(), NotifyError> {
+        self.send("READY=1")
     }
 
     /// A one-line status shown by `systemctl status`. Line breaks are replaced, since a newline
     /// would start another assignment in the datagram.
-    pub fn status(&self, text: &str) {
+    pub fn status(&self, text: &str) -> Result<(), NotifyError> {
         let line: String = text
             .chars()
             .map(|c| if c == '\n' || c == '\r' { ' ' } else { c })
             .collect();
-        self.send(&format!("STATUS={line}"));
+        self.send(&format!("STATUS={line}"))
     }
 
     /// Resets systemd's watchdog timer.
-    pub fn watchdog(&self) {
-        self.send("WATCHDOG=1");
+    pub fn watchdog(&self) -> Result<(), NotifyError> {
+        self.send("WATCHDOG=1")
     }
 
     /// Shutdown has begun.
-    pub fn stopping(&self) {
-        self.send("STOPPING=1");
+    pub fn stopping(&self) -> Result<(), NotifyError> {
+        self.send("STOPPING=1")
     }
 
     /// How many notifications could not be sent.
@@ -122,17 +140,21 @@ impl Notifier {
         self.failures.load(Ordering::Relaxed)
     }
 
-    /// Sends one datagram; a failure is reported once and otherwise ignored.
-    pub fn send(&self, message: &str) {
+    /// Sends one datagram. The first failure is returned; later ones are only counted
+    /// ([`failures`](Self::failures)), so the caller reports a broken socket once.
+    pub fn send(&self, message: &str) -> Result<(), NotifyError> {
         let Some((socket, address)) = &self.target else {
-            return;
+            return Ok(());
         };
-        if let Err(e) = socket.send_to_addr(message.as_bytes(), address) {
-            self.failures.fetch_add(1, Ordering::Relaxed);
-            if !self.warned.swap(true, Ordering::Relaxed) {
-                eprintln!(
-                    "bearingd: cannot notify systemd ({e}); the daemon goes on, later failures are not reported"
-                );
+        match socket.send_to_addr(message.as_bytes(), address) {
+            Ok(_) => Ok(()),
+            Err(e) => {
+                self.failures.fetch_add(1, Ordering::Relaxed);
+                if self.warned.swap(true, Ordering::Relaxed) {
+                    Ok(())
+                } else {
+                    Err(NotifyError::Send(e))
+                }
             }
         }
     }
@@ -160,8 +182,8 @@ fn open(name: &str) -> std::io::Result<(UnixDatagram, SocketAddr)> {
 }
 
 /// Sends `STATUS=` every `status_every` and `WATCHDOG=1` every half watchdog interval while
-/// `alive()` says the pipeline made progress (or has nothing to do). Never resolves; with no
-/// notify socket it only waits.
+/// `alive()` says the pipeline made progress (or has nothing to do); the first failure goes to
+/// `problem`. Never resolves; with no notify socket it only waits.
 ///
 /// When `alive()` says no, the ping is skipped: if that lasts for the whole watchdog interval,
 /// systemd kills and (with `Restart=on-failure`) restarts the daemon, which is the point.
@@ -170,6 +192,7 @@ pub async fn keep_alive(
     status_every: Duration,
     mut status: impl FnMut() -> String,
     mut alive: impl FnMut() -> bool,
+    mut problem: impl FnMut(NotifyError),
 ) {
     if !notifier.is_enabled() {
         return std::future::pending().await;
@@ -184,15 +207,40 @@ pub async fn keep_alive(
     let mut watchdog_ticker = tokio::time::interval(half.unwrap_or(Duration::from_secs(24 * 3600)));
     watchdog_ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     loop {
-        tokio::select! {
+        let sent = tokio::select! {
             _ = status_ticker.tick() => notifier.status(&status()),
             _ = watchdog_ticker.tick() => {
                 if half.is_some() && alive() {
-                    notifier.watchdog();
+                    notifier.watchdog()
+                } else {
+                    Ok(())
                 }
             }
+        };
+        if let Err(e) = sent {
+            problem(e);
         }
     }
+}
+
+/// The one-line `STATUS=` for systemd (`systemctl status`): channel count, then per channel its
+/// sample time, health stage and raised flags; shorter than the command line's status lines.
+pub fn status_text(board: &[ChannelStatus]) -> String {
+    let channels: Vec<String> = board
+        .iter()
+        .map(|s| {
+            let lost = if s.sensor_lost { " SENSOR LOST" } else { "" };
+            format!(
+                "{} t={:.1}s {} {}{lost}",
+                s.channel,
+                s.seconds,
+                s.stage,
+                s.flags_summary()
+            )
+        })
+        .collect();
+    let plural = if board.len() == 1 { "" } else { "s" };
+    format!("{} channel{plural}; {}", board.len(), channels.join("; "))
 }
 
 #[cfg(test)]
@@ -201,16 +249,16 @@ mod tests {
 
     #[test]
     fn unset_socket_is_a_no_op() {
-        let notifier = Notifier::from_parts(None, Some("30000000"), None, 1);
+        let notifier = Notifier::from_parts(None, Some("30000000"), None, 1).0;
         assert!(!notifier.is_enabled());
         assert_eq!(notifier.watchdog_interval(), None);
-        notifier.ready();
+        let _ = notifier.ready();
         assert_eq!(notifier.failures(), 0);
     }
 
     #[test]
     fn relative_path_is_refused() {
-        let notifier = Notifier::from_parts(Some("relative/sock"), None, None, 1);
+        let notifier = Notifier::from_parts(Some("relative/sock"), None, None, 1).0;
         assert!(!notifier.is_enabled());
     }
 
@@ -226,13 +274,14 @@ mod tests {
             Some("2000000"),
             Some(&pid.to_string()),
             pid,
-        );
+        )
+        .0;
         assert!(notifier.is_enabled());
         assert_eq!(notifier.watchdog_interval(), Some(Duration::from_secs(2)));
-        notifier.ready();
-        notifier.status("1 channel;\nmotor-de/radial ok");
-        notifier.watchdog();
-        notifier.stopping();
+        let _ = notifier.ready();
+        let _ = notifier.status("1 channel;\nmotor-de/radial ok");
+        let _ = notifier.watchdog();
+        let _ = notifier.stopping();
         let mut received = Vec::new();
         let mut buffer = [0u8; 4096];
         for _ in 0..4 {
@@ -254,7 +303,7 @@ mod tests {
 
     #[test]
     fn watchdog_for_another_pid_is_ignored() {
-        let notifier = Notifier::from_parts(Some("@x"), Some("2000000"), Some("1"), 2);
+        let notifier = Notifier::from_parts(Some("@x"), Some("2000000"), Some("1"), 2).0;
         assert!(notifier.is_enabled());
         assert_eq!(notifier.watchdog_interval(), None);
     }
@@ -262,9 +311,9 @@ mod tests {
     #[test]
     fn missing_listener_is_counted_not_fatal() {
         let path = std::env::temp_dir().join(format!("bearingd-no-such-{}", std::process::id()));
-        let notifier = Notifier::from_parts(path.to_str(), None, None, 1);
-        notifier.ready();
-        notifier.ready();
+        let notifier = Notifier::from_parts(path.to_str(), None, None, 1).0;
+        let _ = notifier.ready();
+        let _ = notifier.ready();
         assert_eq!(notifier.failures(), 2);
     }
 }

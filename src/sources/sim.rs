@@ -2,9 +2,9 @@
 //! simulator per axis, quantised to the counts a real node would send. It makes
 //! `bearingd run` show the whole loop on a machine with no sensor.
 
-use super::messages::ChannelId;
-use super::pipeline::Input;
 use crate::config::{SensorConfig, SimConfig, SimFault};
+use crate::messages::ChannelId;
+use crate::pipeline::Input;
 use crate::twin::{SimulatedFault, SimulationParams, Simulator};
 
 /// Produces a sensor's blocks, axis by axis, in sample time.

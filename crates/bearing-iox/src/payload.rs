@@ -8,7 +8,7 @@
 //! so that a publisher written in another crate or language matches it (docs/WIRE_FORMAT.md,
 //! "iceoryx2 payload").
 
-#[cfg(feature = "shm")]
+#[cfg(feature = "iceoryx2")]
 use iceoryx2::prelude::ZeroCopySend;
 
 /// Layout version of [`FrameBatch`]; a receiver refuses any other value.
@@ -23,7 +23,7 @@ pub const MAX_FRAME_LEN: usize = 64;
 /// One CAN frame as it would appear on the bus: 11-bit id, data length, data bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(
-    feature = "shm",
+    feature = "iceoryx2",
     derive(ZeroCopySend),
     type_name("bearingd::WireFrame")
 )]
@@ -71,7 +71,7 @@ impl WireFrame {
 /// Up to 64 frames in one shared-memory sample.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(
-    feature = "shm",
+    feature = "iceoryx2",
     derive(ZeroCopySend),
     type_name("bearingd::FrameBatch")
 )]

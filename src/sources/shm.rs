@@ -17,11 +17,13 @@
 //! not put under a systemd `PrivateTmp=`.
 
 use super::handoff::{self, WhenFull};
-use super::payload::FrameBatch;
 use super::{
     node_of, Assembler, EventSender, IngestEvent, SilenceWatch, SourceSummary, StatsTimer,
 };
-use iceoryx2::port::backpressure_strategy::BackpressureStrategy;
+use crate::iox::{
+    create_node, open_data_service, open_event_service, FrameBatch, IoxSettings, ServiceNames,
+    ShmError,
+};
 use iceoryx2::prelude::*;
 use std::future::Future;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -31,126 +33,6 @@ use tokio::time::Instant;
 
 /// Longest wait of the port thread between checks.
 pub const POLL_PERIOD: Duration = Duration::from_millis(20);
-
-/// Batches the subscriber's iceoryx2 buffer holds.
-pub const SUBSCRIBER_BUFFER: usize = 64;
-
-/// iceoryx2 settings shared by publisher and subscriber.
-#[derive(Debug, Clone, Default)]
-pub struct IoxSettings {
-    /// File-name prefix of every iceoryx2 resource (iceoryx2 `global.prefix`); `None` keeps
-    /// iceoryx2's default. Different prefixes never see each other: used for test isolation.
-    pub prefix: Option<String>,
-    /// iceoryx2 root path (`global.root-path`); `None` keeps the default.
-    pub root_path: Option<String>,
-}
-
-/// Why an iceoryx2 port could not be set up. Messages name the service.
-#[derive(Debug, thiserror::Error)]
-pub enum ShmError {
-    #[error("iceoryx2: invalid setting {what} = {value:?}")]
-    Setting { what: &'static str, value: String },
-    #[error("iceoryx2: cannot create the node: {0}")]
-    Node(String),
-    #[error("iceoryx2 service {service}: {detail}")]
-    Service { service: String, detail: String },
-    #[error("iceoryx2 source thread: {0}")]
-    Thread(String),
-}
-
-/// Service names of one sensor.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ServiceNames {
-    pub data: String,
-    pub wake: String,
-    pub ready: String,
-}
-
-impl ServiceNames {
-    pub fn for_sensor(sensor: &str) -> ServiceNames {
-        let data = format!("bearingd/accel/{sensor}");
-        ServiceNames {
-            wake: format!("{data}/wake"),
-            ready: format!("{data}/ready"),
-            data,
-        }
-    }
-}
-
-/// An iceoryx2 node with bearingd's settings.
-pub fn create_node(settings: &IoxSettings) -> Result<Node<ipc::Service>, ShmError> {
-    let mut config = Config::default();
-    if let Some(prefix) = &settings.prefix {
-        config.global.prefix = FileName::new(prefix.as_bytes()).map_err(|_| ShmError::Setting {
-            what: "prefix",
-            value: prefix.clone(),
-        })?;
-    }
-    if let Some(root) = &settings.root_path {
-        let path = Path::new(root.as_bytes()).map_err(|_| ShmError::Setting {
-            what: "root_path",
-            value: root.clone(),
-        })?;
-        config.global.set_root_path(&path);
-    }
-    NodeBuilder::new()
-        .config(&config)
-        .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<ipc::Service>()
-        .map_err(|e| ShmError::Node(format!("{e:?}")))
-}
-
-fn service_name(name: &str) -> Result<ServiceName, ShmError> {
-    ServiceName::new(name).map_err(|e| ShmError::Service {
-        service: name.to_string(),
-        detail: format!("invalid name: {e:?}"),
-    })
-}
-
-/// The data service, with the shape both ends agree on: no safe overflow (a full subscriber
-/// buffer is the publisher's decision: wait, or discard and let the receiver count a gap).
-pub fn open_data_service(
-    node: &Node<ipc::Service>,
-    names: &ServiceNames,
-) -> Result<
-    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, FrameBatch, ()>,
-    ShmError,
-> {
-    node.service_builder(&service_name(&names.data)?)
-        .publish_subscribe::<FrameBatch>()
-        .enable_safe_overflow(false)
-        .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
-        .max_publishers(4)
-        .max_subscribers(4)
-        .open_or_create()
-        .map_err(|e| ShmError::Service {
-            service: names.data.clone(),
-            detail: format!("open or create: {e:?}"),
-        })
-}
-
-/// An event service (wake-up or ready).
-pub fn open_event_service(
-    node: &Node<ipc::Service>,
-    name: &str,
-) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, ShmError> {
-    node.service_builder(&service_name(name)?)
-        .event()
-        .open_or_create()
-        .map_err(|e| ShmError::Service {
-            service: name.to_string(),
-            detail: format!("open or create: {e:?}"),
-        })
-}
-
-/// The publisher's backpressure choice, re-exported for the simulator.
-pub fn backpressure(block: bool) -> BackpressureStrategy {
-    if block {
-        BackpressureStrategy::RetryUntilDelivered
-    } else {
-        BackpressureStrategy::DiscardData
-    }
-}
 
 /// How the iceoryx2 source is set up.
 #[derive(Debug, Clone)]

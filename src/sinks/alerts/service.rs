@@ -16,7 +16,7 @@
 
 use super::payload::Alert;
 use super::PublisherSummary;
-use crate::ingest::shm::{create_node, open_event_service, IoxSettings};
+use crate::iox::{create_node, open_event_service, wake_service, IoxSettings};
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -38,6 +38,21 @@ pub enum AlertError {
     Service { service: String, detail: String },
     #[error("alert publisher thread: {0}")]
     Thread(String),
+    #[error("alert #{sequence} could not be published on {service}: {detail}")]
+    Publish {
+        sequence: u64,
+        service: String,
+        detail: String,
+    },
+}
+
+/// An alert that found the queue to the publisher thread full: not published.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("alert #{sequence} not published: the alert queue is full ({dropped} dropped so far)")]
+pub struct AlertDropped {
+    pub sequence: u64,
+    /// Alerts dropped since the publisher started, this one included.
+    pub dropped: u64,
 }
 
 /// Where the alert service is.
@@ -50,18 +65,13 @@ pub struct AlertServiceSettings {
 
 impl AlertServiceSettings {
     fn wake_name(&self) -> String {
-        format!("{}/wake", self.service)
+        wake_service(&self.service)
     }
 
     fn error(&self, detail: impl Into<String>) -> AlertError {
-        let root = self
-            .iox
-            .root_path
-            .as_deref()
-            .unwrap_or("iceoryx2's default");
         AlertError::Service {
             service: self.service.clone(),
-            detail: format!("{} (iceoryx2 root {root})", detail.into()),
+            detail: format!("{} (iceoryx2 root {})", detail.into(), self.iox.root_name()),
         }
     }
 
@@ -79,16 +89,20 @@ pub struct AlertPublisher {
 
 impl AlertPublisher {
     /// Creates the services and the publisher on a new thread; returns once they exist, or
-    /// with the reason they could not be created.
+    /// with the reason they could not be created. An alert the thread then fails to publish
+    /// goes to `on_failure` (the daemon reports it) and the thread goes on.
     pub fn start(
         settings: AlertServiceSettings,
         history_size: usize,
+        on_failure: impl Fn(AlertError) + Send + 'static,
     ) -> Result<AlertPublisher, AlertError> {
         let (queue, alerts) = mpsc::sync_channel::<Alert>(QUEUE);
         let (started_tx, started_rx) = mpsc::sync_channel::<Result<(), AlertError>>(1);
         let thread = std::thread::Builder::new()
             .name("bearingd-alerts".into())
-            .spawn(move || publisher_thread(&settings, history_size, &alerts, &started_tx))
+            .spawn(move || {
+                publisher_thread(&settings, history_size, &alerts, &started_tx, &on_failure)
+            })
             .map_err(|e| AlertError::Thread(e.to_string()))?;
         match started_rx.recv() {
             Ok(Ok(())) => Ok(AlertPublisher {
@@ -107,15 +121,17 @@ impl AlertPublisher {
         }
     }
 
-    /// Queues one alert for publishing; a full queue counts the alert as dropped and says so.
-    pub fn send(&self, alert: Alert) {
+    /// Queues one alert for publishing; a full queue counts the alert as dropped and says so
+    /// in the error.
+    pub fn send(&self, alert: Alert) -> Result<(), AlertDropped> {
         if self.queue.try_send(alert).is_err() {
             let dropped = self.dropped.fetch_add(1, Ordering::Relaxed) + 1;
-            eprintln!(
-                "bearingd: alert #{} not published: the alert queue is full ({dropped} dropped so far)",
-                alert.sequence
-            );
+            return Err(AlertDropped {
+                sequence: alert.sequence,
+                dropped,
+            });
         }
+        Ok(())
     }
 
     /// Publishes what is queued, closes the ports and reports.
@@ -134,6 +150,7 @@ fn publisher_thread(
     history_size: usize,
     alerts: &mpsc::Receiver<Alert>,
     started: &mpsc::SyncSender<Result<(), AlertError>>,
+    on_failure: &impl Fn(AlertError),
 ) -> u64 {
     let setup = (|| {
         let node = create_node(&settings.iox).map_err(|e| settings.error(e.to_string()))?;
@@ -181,10 +198,11 @@ fn publisher_thread(
                     published += 1;
                     let _ = wake.notify();
                 }
-                Err(e) => eprintln!(
-                    "bearingd: alert #{} could not be published on {}: {e:?}",
-                    alert.sequence, settings.service
-                ),
+                Err(e) => on_failure(AlertError::Publish {
+                    sequence: alert.sequence,
+                    service: settings.service.clone(),
+                    detail: format!("{e:?}"),
+                }),
             },
             Err(mpsc::RecvTimeoutError::Timeout) => {
                 let _ = publisher.update_connections();
@@ -334,8 +352,8 @@ impl AlertSubscriber {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::alerts::payload::{name_field, AlertState, ALERT_VERSION};
-    use crate::recording::testdata::scratch_dir;
+    use crate::sinks::alerts::payload::{name_field, AlertState, ALERT_VERSION};
+    use bearingd_testdata::scratch_dir;
 
     fn alert(sequence: u64) -> Alert {
         Alert {
@@ -380,14 +398,14 @@ mod tests {
     #[test]
     fn a_subscriber_that_falls_behind_is_told_which_alerts_it_lost() {
         let settings = settings("lost");
-        let publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
+        let publisher = AlertPublisher::start(settings.clone(), 16, |e| eprintln!("{e}")).unwrap();
         let mut subscriber = AlertSubscriber::open(&settings).unwrap();
         assert!(subscriber
             .take_history(Duration::from_millis(300))
             .is_empty());
         let total = SUBSCRIBER_BUFFER as u64 + 44;
         for sequence in 1..=total {
-            publisher.send(alert(sequence));
+            let _ = publisher.send(alert(sequence));
             if sequence % 64 == 0 {
                 std::thread::sleep(Duration::from_millis(20)); // let the thread keep up
             }
@@ -418,9 +436,9 @@ mod tests {
     #[test]
     fn a_late_subscriber_receives_the_history_then_live_alerts_and_restarts() {
         let settings = settings("history");
-        let publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
+        let publisher = AlertPublisher::start(settings.clone(), 16, |e| eprintln!("{e}")).unwrap();
         for sequence in 1..=20 {
-            publisher.send(alert(sequence));
+            let _ = publisher.send(alert(sequence));
         }
         std::thread::sleep(Duration::from_millis(200));
         let mut subscriber = AlertSubscriber::open(&settings).unwrap();
@@ -433,19 +451,19 @@ mod tests {
             })
             .collect();
         assert_eq!(sequences, (5..=20).collect::<Vec<_>>(), "{history:?}");
-        publisher.send(alert(21));
+        let _ = publisher.send(alert(21));
         assert_eq!(
             subscriber.next(Duration::from_secs(5)),
             Some(Received::Alert(alert(21)))
         );
         // The daemon restarts: a new run id, numbers from 1 again.
         publisher.finish();
-        let publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
+        let publisher = AlertPublisher::start(settings.clone(), 16, |e| eprintln!("{e}")).unwrap();
         let restarted = Alert {
             run_id: 43,
             ..alert(1)
         };
-        publisher.send(restarted);
+        let _ = publisher.send(restarted);
         assert_eq!(
             subscriber.next(Duration::from_secs(5)),
             Some(Received::NewRun { run_id: 43 })

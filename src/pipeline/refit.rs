@@ -1,9 +1,9 @@
 //! The twin's periodic re-fit, on its own thread (FFT-heavy work never runs on the async
 //! side), warm-started per channel from the previous fit.
 
-use super::messages::{ChannelId, TwinMessage};
-use super::pipeline::TwinRequest;
+use super::TwinRequest;
 use crate::analysis::envelope::{window_samples, FftPlans};
+use crate::messages::{ChannelId, TwinMessage};
 use crate::twin::diagnose::fit_record;
 use crate::twin::{TwinFitter, TwinParams};
 use std::collections::BTreeMap;
@@ -44,11 +44,11 @@ impl TwinWorker {
         );
         let best = twin.best_fit();
         let error_of = |kind| twin.error_of(kind).unwrap_or(f64::NAN);
-        use crate::analysis::FaultKind::{Ball, InnerRace, OuterRace};
+        use crate::messages::FaultKind::{Ball, InnerRace, OuterRace};
         Some(TwinMessage {
             channel: request.channel.clone(),
             end_sample: request.end_sample,
-            hypothesis: best.fault.name().into(),
+            hypothesis: best.fault,
             error: best.error,
             margin: twin.margin,
             error_outer_race: error_of(OuterRace),

@@ -1,14 +1,14 @@
-//! The live sources of `bearingd run`: the SocketCAN and iceoryx2 sources of
-//! [`crate::ingest`], with their events mapped from (node, axis) to the config's channels.
+//! The live sources of `bearingd run`: the SocketCAN and iceoryx2 sources of this room, with
+//! their events mapped from (node, axis) to the config's channels.
 //!
 //! One task per CAN interface (several nodes share a bus) and per iceoryx2 sensor. A source
 //! waits when the analysis queue is full, which pushes the loss back into the transport's own
 //! buffer, where it is counted as an exact sequence gap.
 
-use super::messages::{ChannelId, IngestMessage};
-use super::pipeline::Input;
+use super::{IngestEvent, IngestStats};
 use crate::config::{Config, SensorConfig, Transport};
-use crate::ingest::{IngestEvent, IngestStats};
+use crate::messages::{ChannelId, IngestMessage};
+use crate::pipeline::Input;
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -91,9 +91,7 @@ pub fn shm_sensors(config: &Config) -> Vec<(String, NodeMap)> {
         .iter()
         .filter_map(|sensor| match &sensor.transport {
             Transport::Shm(shm) => {
-                let name = shm
-                    .service
-                    .strip_prefix("bearingd/accel/")
+                let name = crate::iox::sensor_of_service(&shm.service)
                     .unwrap_or(&sensor.id)
                     .to_string();
                 let mut map = NodeMap::default();
@@ -121,7 +119,7 @@ impl Arrived {
     pub fn now(input: Input) -> Arrived {
         Arrived {
             input,
-            wall_ns: crate::mcap_log::wall_clock_now_ns(),
+            wall_ns: super::wall_clock_now_ns(),
         }
     }
 }

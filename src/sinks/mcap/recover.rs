@@ -20,9 +20,9 @@ use std::path::{Path, PathBuf};
 use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions};
 
-use super::error::{io_err, McapLogError, Result};
-use super::scan::{ScannedRecord, Scanner};
-use super::writer::is_log_file_name;
+use crate::mcap_log::error::{io_err, McapLogError, Result};
+use crate::mcap_log::files::is_log_file_name;
+use crate::mcap_log::scan::{ScannedRecord, Scanner};
 
 /// What recovering one file did.
 #[derive(Debug, Clone, PartialEq, Eq)]

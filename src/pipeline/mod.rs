@@ -1,22 +1,32 @@
-//! The analysis stage of the daemon, shared by `run` and `replay`: inputs in sample time
-//! (sample blocks and sensor events, whatever their source) → one [`ChannelMonitor`] per
-//! channel → messages for the sinks, and requests for the twin's re-fit.
+//! The per-channel pipeline, shared by `run` and `replay`: inputs in sample time (sample blocks
+//! and sensor events, whatever their source) → one [`ChannelMonitor`] per channel →
+//! [`Output`]s: messages for the sinks, and requests for the twin's re-fit ([`refit`]).
 //!
 //! Synchronous and single-threaded on purpose: it runs on its own thread in `run` and in
 //! `replay` alike, and its outputs depend only on its inputs, so a replay of the logged raw
 //! samples gives the same flags at the same samples.
+//!
+//! [`Sink`] is the seam to the sinks: the pipeline's messages go to whatever implements it
+//! (the MCAP log, the command line's flag printer), and the pipeline knows none of them.
 
-use super::messages::{
-    ChannelId, FlagMessage, HealthMessage, IndicatorsMessage, IngestMessage, PipelineMessage,
-    RawBlock, SpectrumMessage, SpeedMessage,
-};
-use crate::analysis::flags::{FlagLevel, FlagSettings};
-use crate::analysis::health::{Baseline, HealthStage};
+pub mod refit;
+mod sink;
+
+pub use refit::TwinWorker;
+pub use sink::{Sink, SinkError};
+
+use crate::analysis::flags::FlagSettings;
+use crate::analysis::health::Baseline;
 use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings, SpeedMode};
 use crate::analysis::speed::SpeedSearch;
-use crate::analysis::{Band, FaultKind};
+use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
 use crate::config::{Config, SensorConfig, Speed};
+use crate::messages::{
+    ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage, HealthStage,
+    IndicatorsMessage, IngestMessage, PipelineMessage, RawBlock, SpectrumMessage, SpeedMessage,
+    SpeedSource,
+};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -74,14 +84,13 @@ pub enum Output {
     Twin(TwinRequest),
 }
 
-/// The latest state of a channel, for status lines and the exit summary.
+/// The latest state of a channel, for status lines, systemd's status and the exit summary.
 #[derive(Debug, Clone, Serialize)]
 pub struct ChannelStatus {
     pub channel: ChannelId,
     /// The speed the channel scores with; `None` while it has none (see `speed_source`).
     pub rpm: Option<f64>,
-    /// `fixed`, `can` or `estimate`.
-    pub speed_source: &'static str,
+    pub speed_source: SpeedSource,
     pub samples: u64,
     pub seconds: f64,
     pub band_hz: Option<[f64; 2]>,
@@ -91,10 +100,28 @@ pub struct ChannelStatus {
     pub stage: HealthStage,
     pub gaps: u64,
     pub missing_samples: u64,
-    pub twin_hypothesis: Option<String>,
+    pub twin_hypothesis: Option<FaultKind>,
     pub twin_error: Option<f64>,
     pub sensor_lost: bool,
     pub flag_changes: u64,
+}
+
+impl ChannelStatus {
+    /// The raised flags as `fault=level` joined by commas (`outer_race=alarm,ball=watch`), or
+    /// `ok` when none is raised.
+    pub fn flags_summary(&self) -> String {
+        let raised: Vec<String> = FaultKind::ALL
+            .iter()
+            .zip(&self.flags)
+            .filter(|(_, level)| **level != FlagLevel::Ok)
+            .map(|(fault, level)| format!("{fault}={level}"))
+            .collect();
+        if raised.is_empty() {
+            "ok".to_string()
+        } else {
+            raised.join(",")
+        }
+    }
 }
 
 struct Channel {
@@ -226,7 +253,7 @@ impl Pipeline {
                 let status = ChannelStatus {
                     channel: id.clone(),
                     rpm: monitor.shaft_hz().map(|hz| hz * 60.0),
-                    speed_source: sensor.speed.source_name(),
+                    speed_source: sensor.speed.source(),
                     samples: 0,
                     seconds: 0.0,
                     band_hz: None,
@@ -284,9 +311,9 @@ impl Pipeline {
     }
 
     /// Records the twin's latest result in the channel's status.
-    pub fn note_twin(&mut self, channel: &ChannelId, hypothesis: &str, error: f64) {
+    pub fn note_twin(&mut self, channel: &ChannelId, hypothesis: FaultKind, error: f64) {
         if let Some(c) = self.channels.get_mut(channel) {
-            c.status.twin_hypothesis = Some(hypothesis.to_string());
+            c.status.twin_hypothesis = Some(hypothesis);
             c.status.twin_error = Some(error);
         }
     }
@@ -365,7 +392,7 @@ impl Pipeline {
             }
             Input::LoggedSpeed(logged) => {
                 let spectrum_every_s = self.spectrum_every_s;
-                if logged.source == "can" {
+                if logged.source == SpeedSource::Can {
                     if let Some(c) = self.channels.get_mut(&logged.channel) {
                         c.speed_at(
                             &logged.channel,
@@ -388,7 +415,7 @@ impl Pipeline {
                     out(Output::Message(PipelineMessage::Health(HealthMessage {
                         channel: channel.clone(),
                         end_sample: c.monitor.next_sample(),
-                        kind: "restart".into(),
+                        kind: HealthKind::Restart,
                         stage: None,
                         detail: format!(
                             "the sensor node restarted; its samples start again at {first_sample}"
@@ -409,7 +436,11 @@ impl Pipeline {
             out(Output::Message(PipelineMessage::Health(HealthMessage {
                 channel: id.clone(),
                 end_sample: c.monitor.next_sample(),
-                kind: if lost { "lost".into() } else { "back".into() },
+                kind: if lost {
+                    HealthKind::Lost
+                } else {
+                    HealthKind::Back
+                },
                 stage: None,
                 detail: if lost {
                     "no frame from the sensor within its timeout".into()
@@ -476,9 +507,9 @@ fn handle_event(
             PipelineMessage::Flag(FlagMessage {
                 channel: channel.clone(),
                 end_sample: change.at_sample,
-                fault: fault.name().into(),
-                from: change.from.name().into(),
-                to: change.to.name().into(),
+                fault,
+                from: change.from,
+                to: change.to,
                 score,
                 fault_frequency_hz: frequency_hz,
             })
@@ -486,9 +517,9 @@ fn handle_event(
         MonitorEvent::Stage(change) => PipelineMessage::Health(HealthMessage {
             channel: channel.clone(),
             end_sample: change.at_sample,
-            kind: "stage".into(),
-            stage: Some(change.to.name().into()),
-            detail: format!("health stage {} → {}", change.from.name(), change.to.name()),
+            kind: HealthKind::Stage,
+            stage: Some(change.to),
+            detail: format!("health stage {} → {}", change.from, change.to),
         }),
         MonitorEvent::Sensor {
             condition,
@@ -497,12 +528,12 @@ fn handle_event(
         } => PipelineMessage::Health(HealthMessage {
             channel: channel.clone(),
             end_sample: at_sample,
-            kind: condition.name().into(),
+            kind: condition.into(),
             stage: None,
             detail: if active {
-                format!("{} started", condition.name())
+                format!("{} started", HealthKind::from(condition))
             } else {
-                format!("{} ended", condition.name())
+                format!("{} ended", HealthKind::from(condition))
             },
         }),
         MonitorEvent::Gap { at_sample, missing } => {
@@ -511,7 +542,7 @@ fn handle_event(
             PipelineMessage::Health(HealthMessage {
                 channel: channel.clone(),
                 end_sample: at_sample,
-                kind: "gap".into(),
+                kind: HealthKind::Gap,
                 stage: None,
                 detail: format!(
                     "{missing} samples missing; the analysis windows restart after the gap"
@@ -528,7 +559,11 @@ fn handle_event(
             PipelineMessage::Speed(SpeedMessage {
                 channel: channel.clone(),
                 end_sample: at_sample,
-                source: if estimated { "estimate" } else { "can" }.into(),
+                source: if estimated {
+                    SpeedSource::Estimate
+                } else {
+                    SpeedSource::Can
+                },
                 given_rpm: given_hz.map(|hz| hz * 60.0),
                 rpm: shaft_hz.map(|hz| hz * 60.0),
             })
@@ -540,7 +575,7 @@ fn handle_event(
         } => PipelineMessage::Health(HealthMessage {
             channel: channel.clone(),
             end_sample: at_sample,
-            kind: "bands".into(),
+            kind: HealthKind::Bands,
             stage: None,
             detail: format!(
                 "bands re-selected: outer {} inner {} ball {} cage {} (method's choice {})",

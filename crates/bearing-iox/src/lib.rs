@@ -1,0 +1,192 @@
+//! bearingd's iceoryx2 conventions, in one place for the daemon and for the programs that
+//! publish to it (`firmware-sim`): the service names under `bearingd/`, the settings every node
+//! is created with (file prefix, root path, no signal handling), the shapes of the data and
+//! event services, and the sample payload ([`FrameBatch`]).
+//!
+//! Why a crate of its own: a publisher must agree with the daemon on every one of these, and
+//! a sensor simulator should not have to link the whole daemon to do so.
+//!
+//! Feature `iceoryx2` (default): the node and service helpers and the payload's `ZeroCopySend`
+//! derive. Without it only the names and settings remain (what the daemon's config needs when
+//! it is built without iceoryx2).
+
+#![forbid(unsafe_code)]
+#![cfg_attr(test, allow(clippy::unwrap_used, clippy::expect_used))]
+
+pub mod payload;
+
+pub use payload::{
+    BatchError, FrameBatch, WireFrame, FRAMES_PER_BATCH, FRAME_BATCH_VERSION, MAX_FRAME_LEN,
+};
+
+#[cfg(feature = "iceoryx2")]
+use iceoryx2::port::backpressure_strategy::BackpressureStrategy;
+#[cfg(feature = "iceoryx2")]
+use iceoryx2::prelude::*;
+
+/// Every bearingd service name starts with this.
+pub const SERVICE_ROOT: &str = "bearingd/";
+
+/// Prefix of a sensor's sample service: `bearingd/accel/<sensor>`.
+pub const SENSOR_SERVICE_PREFIX: &str = "bearingd/accel/";
+
+/// The environment variable that sets the iceoryx2 file prefix of the daemon and of
+/// `bearingd alerts` (for isolated tests; unset in production).
+pub const PREFIX_ENV: &str = "BEARINGD_IOX_PREFIX";
+
+/// Batches a sample subscriber's iceoryx2 buffer holds.
+pub const SUBSCRIBER_BUFFER: usize = 64;
+
+/// iceoryx2 settings shared by publisher and subscriber.
+#[derive(Debug, Clone, Default)]
+pub struct IoxSettings {
+    /// File-name prefix of every iceoryx2 resource (iceoryx2 `global.prefix`); `None` keeps
+    /// iceoryx2's default. Different prefixes never see each other: used for test isolation.
+    pub prefix: Option<String>,
+    /// iceoryx2 root path (`global.root-path`); `None` keeps the default.
+    pub root_path: Option<String>,
+}
+
+impl IoxSettings {
+    /// The daemon's settings: the root path `root` (`outputs.iceoryx2_root`) and the file
+    /// prefix from [`PREFIX_ENV`] when it is set.
+    pub fn with_root(root: &std::path::Path) -> IoxSettings {
+        IoxSettings {
+            prefix: std::env::var(PREFIX_ENV).ok(),
+            root_path: Some(root.display().to_string()),
+        }
+    }
+
+    /// How messages name the root: the path, or "iceoryx2's default".
+    pub fn root_name(&self) -> &str {
+        self.root_path.as_deref().unwrap_or("iceoryx2's default")
+    }
+}
+
+/// Why an iceoryx2 port could not be set up. Messages name the service.
+#[derive(Debug, thiserror::Error)]
+pub enum ShmError {
+    #[error("iceoryx2: invalid setting {what} = {value:?}")]
+    Setting { what: &'static str, value: String },
+    #[error("iceoryx2: cannot create the node: {0}")]
+    Node(String),
+    #[error("iceoryx2 service {service}: {detail}")]
+    Service { service: String, detail: String },
+    #[error("iceoryx2 source thread: {0}")]
+    Thread(String),
+}
+
+/// The sample service of `sensor`: `bearingd/accel/<sensor>`.
+pub fn sensor_service(sensor: &str) -> String {
+    format!("{SENSOR_SERVICE_PREFIX}{sensor}")
+}
+
+/// The sensor name of a sample service, if it has the form `bearingd/accel/<sensor>`.
+pub fn sensor_of_service(service: &str) -> Option<&str> {
+    service.strip_prefix(SENSOR_SERVICE_PREFIX)
+}
+
+/// The event service a publisher notifies after each sample of `service`.
+pub fn wake_service(service: &str) -> String {
+    format!("{service}/wake")
+}
+
+/// Service names of one sensor.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ServiceNames {
+    pub data: String,
+    pub wake: String,
+    pub ready: String,
+}
+
+impl ServiceNames {
+    pub fn for_sensor(sensor: &str) -> ServiceNames {
+        let data = sensor_service(sensor);
+        ServiceNames {
+            wake: wake_service(&data),
+            ready: format!("{data}/ready"),
+            data,
+        }
+    }
+}
+
+#[cfg(feature = "iceoryx2")]
+/// An iceoryx2 node with bearingd's settings.
+pub fn create_node(settings: &IoxSettings) -> Result<Node<ipc::Service>, ShmError> {
+    let mut config = Config::default();
+    if let Some(prefix) = &settings.prefix {
+        config.global.prefix = FileName::new(prefix.as_bytes()).map_err(|_| ShmError::Setting {
+            what: "prefix",
+            value: prefix.clone(),
+        })?;
+    }
+    if let Some(root) = &settings.root_path {
+        let path = Path::new(root.as_bytes()).map_err(|_| ShmError::Setting {
+            what: "root_path",
+            value: root.clone(),
+        })?;
+        config.global.set_root_path(&path);
+    }
+    NodeBuilder::new()
+        .config(&config)
+        .signal_handling_mode(SignalHandlingMode::Disabled)
+        .create::<ipc::Service>()
+        .map_err(|e| ShmError::Node(format!("{e:?}")))
+}
+
+#[cfg(feature = "iceoryx2")]
+pub fn service_name(name: &str) -> Result<ServiceName, ShmError> {
+    ServiceName::new(name).map_err(|e| ShmError::Service {
+        service: name.to_string(),
+        detail: format!("invalid name: {e:?}"),
+    })
+}
+
+#[cfg(feature = "iceoryx2")]
+/// The data service, with the shape both ends agree on: no safe overflow (a full subscriber
+/// buffer is the publisher's decision: wait, or discard and let the receiver count a gap).
+pub fn open_data_service(
+    node: &Node<ipc::Service>,
+    names: &ServiceNames,
+) -> Result<
+    iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, FrameBatch, ()>,
+    ShmError,
+> {
+    node.service_builder(&service_name(&names.data)?)
+        .publish_subscribe::<FrameBatch>()
+        .enable_safe_overflow(false)
+        .subscriber_max_buffer_size(SUBSCRIBER_BUFFER)
+        .max_publishers(4)
+        .max_subscribers(4)
+        .open_or_create()
+        .map_err(|e| ShmError::Service {
+            service: names.data.clone(),
+            detail: format!("open or create: {e:?}"),
+        })
+}
+
+#[cfg(feature = "iceoryx2")]
+/// An event service (wake-up or ready).
+pub fn open_event_service(
+    node: &Node<ipc::Service>,
+    name: &str,
+) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, ShmError> {
+    node.service_builder(&service_name(name)?)
+        .event()
+        .open_or_create()
+        .map_err(|e| ShmError::Service {
+            service: name.to_string(),
+            detail: format!("open or create: {e:?}"),
+        })
+}
+
+#[cfg(feature = "iceoryx2")]
+/// The publisher's backpressure choice: wait for a full subscriber (`block`, lossless) or
+/// discard (the receiver counts a gap).
+pub fn backpressure(block: bool) -> BackpressureStrategy {
+    if block {
+        BackpressureStrategy::RetryUntilDelivered
+    } else {
+        BackpressureStrategy::DiscardData
+    }
+}

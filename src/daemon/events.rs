@@ -1,0 +1,65 @@
+//! What the daemon has to tell its operator while it runs: typed events, handed to a callback
+//! the caller gives ([`Events`]). The daemon never prints; the command line decides how each
+//! event reads (`crate::cli`), tests can collect them.
+
+use super::state::StateError;
+use crate::mcap_log::McapLogError;
+use crate::messages::ChannelId;
+use crate::pipeline::ChannelStatus;
+#[cfg(feature = "shm")]
+use crate::sinks::alerts::{AlertDropped, AlertError};
+use crate::sinks::mcap::RecoveryReport;
+use crate::sinks::systemd::NotifyError;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Where the daemon's events go; called from any of its threads.
+pub type Events = Arc<dyn Fn(DaemonEvent) + Send + Sync>;
+
+/// An event handler that drops every event (for library callers that want none).
+pub fn ignore_events() -> Events {
+    Arc::new(|_| {})
+}
+
+/// Something the operator should know.
+#[derive(Debug)]
+pub enum DaemonEvent {
+    /// A file a crash left unfinished was recovered at start.
+    Recovered(RecoveryReport),
+    /// The MCAP log's first file is open.
+    LoggingTo(PathBuf),
+    /// The alert service is up.
+    AlertsOn { service: String, root: PathBuf },
+    /// This bearingd was built without iceoryx2: flags go to the log only.
+    NoAlertService,
+    /// An alert found the publisher's queue full.
+    #[cfg(feature = "shm")]
+    AlertDropped(AlertDropped),
+    /// The publisher thread could not publish an alert.
+    #[cfg(feature = "shm")]
+    AlertFailed(AlertError),
+    /// A live source stopped with an error (`source` names it: `CAN source`, `iceoryx2 source
+    /// bearingd/accel/<sensor>`).
+    SourceStopped { source: String, error: String },
+    /// A source task ended abnormally (it panicked or was cancelled).
+    SourceTaskFailed(String),
+    /// Sample blocks of a channel the config does not know were skipped.
+    UnknownChannel { channel: ChannelId, blocks: u64 },
+    /// The health baselines kept across restarts could not be read (they are learned again),
+    /// or could not be saved at stop.
+    State(StateError),
+    /// systemd could not be notified (said once).
+    Notify(NotifyError),
+    /// Every channel's state, every `outputs.status_interval_s` (when status lines are asked
+    /// for).
+    Status(Vec<ChannelStatus>),
+    /// A message of a replayed log could not be read; the replay goes on.
+    ReplayUnreadable(McapLogError),
+    /// About once a second of a replay.
+    ReplayProgress {
+        sample_seconds: f64,
+        elapsed_s: f64,
+        raw_blocks: u64,
+        flag_changes: usize,
+    },
+}

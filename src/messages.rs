@@ -1,0 +1,363 @@
+//! The vocabulary of the pipeline: the typed kinds (fault, flag level, health stage and event,
+//! speed source) and the messages the per-channel pipeline hands to its sinks (the MCAP log,
+//! alerts, status), one type per MCAP channel. Owned by no adapter: the analysis, the pipeline,
+//! the sources and the sinks all speak it, and only the edges encode it (the MCAP log as JSON
+//! or protobuf, iceoryx2 alerts as integer codes, the command line as text).
+//!
+//! Why typed: a kind is decided once, where it happens, and every consumer matches on it; no
+//! string is parsed back inside the process. The wire form in the MCAP log is the snake_case
+//! name of each variant (`outer_race`, `alarm`, `flat_line`, …), the same strings the log has
+//! always had, so existing readers (Python, Foxglove) keep working.
+//!
+//! Each message carries the channel it belongs to and its position in **sample time**
+//! (`end_sample`: one past the last sample the result covers), so that a replay reproduces
+//! them at the same sample times. Raw samples go to MCAP as protobuf (compact and lossless: the
+//! integers the sensor sent plus its scale), everything else as JSON (low rate, readable
+//! anywhere).
+
+use crate::bearing::FaultFrequencies;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// Implements `Display` as the variant's wire name (`name()`), so text output and the log agree.
+macro_rules! display_as_name {
+    ($($kind:ty),*) => {$(
+        impl fmt::Display for $kind {
+            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+    )*};
+}
+
+/// The fault classes that have a characteristic frequency.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FaultKind {
+    OuterRace,
+    InnerRace,
+    Ball,
+    Cage,
+}
+
+impl FaultKind {
+    pub const ALL: [FaultKind; 4] = [
+        FaultKind::OuterRace,
+        FaultKind::InnerRace,
+        FaultKind::Ball,
+        FaultKind::Cage,
+    ];
+
+    /// The wire name: `outer_race`, `inner_race`, `ball`, `cage`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FaultKind::OuterRace => "outer_race",
+            FaultKind::InnerRace => "inner_race",
+            FaultKind::Ball => "ball",
+            FaultKind::Cage => "cage",
+        }
+    }
+
+    /// Position in [`FaultKind::ALL`] (the order of every per-fault array).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The short label engineers use for the frequency: BPFO, BPFI, 2BSF (twice the ball spin frequency), FTF.
+    pub fn frequency_label(self) -> &'static str {
+        match self {
+            FaultKind::OuterRace => "BPFO",
+            FaultKind::InnerRace => "BPFI",
+            FaultKind::Ball => "2BSF",
+            FaultKind::Cage => "FTF",
+        }
+    }
+
+    /// The repetition frequency of this fault's impacts.
+    pub fn frequency(self, f: &FaultFrequencies) -> f64 {
+        match self {
+            FaultKind::OuterRace => f.bpfo,
+            FaultKind::InnerRace => f.bpfi,
+            FaultKind::Ball => f.two_bsf,
+            FaultKind::Cage => f.ftf,
+        }
+    }
+
+    /// The modulation that makes sidebands around this fault's harmonics, if any.
+    pub fn sideband_spacing(self, f: &FaultFrequencies) -> Option<f64> {
+        match self {
+            FaultKind::InnerRace => Some(f.shaft),
+            FaultKind::Ball => Some(f.ftf),
+            FaultKind::OuterRace | FaultKind::Cage => None,
+        }
+    }
+}
+
+/// A fault flag's level: `ok | watch | alarm`, ordered by severity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FlagLevel {
+    Ok,
+    Watch,
+    Alarm,
+}
+
+impl FlagLevel {
+    pub const ALL: [FlagLevel; 3] = [FlagLevel::Ok, FlagLevel::Watch, FlagLevel::Alarm];
+
+    /// The wire name: `ok`, `watch`, `alarm`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FlagLevel::Ok => "ok",
+            FlagLevel::Watch => "watch",
+            FlagLevel::Alarm => "alarm",
+        }
+    }
+}
+
+/// The bearing's stage of life (MODELS.md §7).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HealthStage {
+    /// Learning the healthy baseline.
+    Learning,
+    Healthy,
+    /// Kurtosis beyond the healthy baseline: impacts have appeared.
+    Degrading,
+    /// RMS beyond its level at the start of degradation: the damage has spread.
+    Failing,
+}
+
+impl HealthStage {
+    /// The wire name: `learning`, `healthy`, `degrading`, `failing`.
+    pub fn name(self) -> &'static str {
+        match self {
+            HealthStage::Learning => "learning",
+            HealthStage::Healthy => "healthy",
+            HealthStage::Degrading => "degrading",
+            HealthStage::Failing => "failing",
+        }
+    }
+}
+
+/// What a [`HealthMessage`] reports.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum HealthKind {
+    /// The source has not heard the sensor within its timeout.
+    Lost,
+    /// The sensor sends again.
+    Back,
+    /// Samples are missing.
+    Gap,
+    /// The sensor node restarted.
+    Restart,
+    /// The signal clips at the sensor's range.
+    Saturation,
+    /// The signal stopped moving.
+    FlatLine,
+    /// The health stage changed ([`HealthMessage::stage`] says to which).
+    Stage,
+    /// The analysis bands were re-selected.
+    Bands,
+}
+
+impl HealthKind {
+    /// The wire name: `lost`, `back`, `gap`, `restart`, `saturation`, `flat_line`, `stage`,
+    /// `bands`.
+    pub fn name(self) -> &'static str {
+        match self {
+            HealthKind::Lost => "lost",
+            HealthKind::Back => "back",
+            HealthKind::Gap => "gap",
+            HealthKind::Restart => "restart",
+            HealthKind::Saturation => "saturation",
+            HealthKind::FlatLine => "flat_line",
+            HealthKind::Stage => "stage",
+            HealthKind::Bands => "bands",
+        }
+    }
+}
+
+/// Where a channel's shaft speed comes from (config `sensors[].speed.source`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpeedSource {
+    /// A fixed speed from the config.
+    Fixed,
+    /// Speed frames of the sensor node (a tachometer on the bus).
+    Can,
+    /// Estimated from the spectrum near a nominal speed.
+    Estimate,
+}
+
+impl SpeedSource {
+    /// The wire name: `fixed`, `can`, `estimate`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SpeedSource::Fixed => "fixed",
+            SpeedSource::Can => "can",
+            SpeedSource::Estimate => "estimate",
+        }
+    }
+}
+
+display_as_name!(FaultKind, FlagLevel, HealthStage, HealthKind, SpeedSource);
+
+/// Identifies one analysed signal: a sensor (node) and one of its axes.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct ChannelId {
+    /// The sensor's id from the config (e.g. `motor-de`).
+    pub sensor: String,
+    /// The axis name from the config (e.g. `radial`).
+    pub axis: String,
+}
+
+impl fmt::Display for ChannelId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.sensor, self.axis)
+    }
+}
+
+/// A block of raw samples exactly as the sensor sent them. MCAP topic `/raw/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RawBlock {
+    pub channel: ChannelId,
+    /// Index of the first sample in the channel's sample time.
+    pub first_sample: u64,
+    pub sample_rate_hz: f64,
+    /// Acceleration in g per count.
+    pub scale_g_per_count: f64,
+    /// The integer counts as sent (i16 on the wire).
+    pub counts: Vec<i32>,
+}
+
+/// The averaged squared-envelope spectrum, at a low rate. Topic `/spectrum/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpectrumMessage {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    pub band_hz: [f64; 2],
+    pub bin_hz: f64,
+    pub windows_averaged: usize,
+    /// Amplitude per bin from 0 Hz, g².
+    pub amplitude: Vec<f32>,
+}
+
+/// Indicators and fault scores of the newest window. Topic `/indicators/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IndicatorsMessage {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    pub rpm: f64,
+    pub band_hz: [f64; 2],
+    pub rms: f64,
+    pub peak: f64,
+    pub crest: f64,
+    pub kurtosis: f64,
+    pub score_outer_race: f64,
+    pub score_inner_race: f64,
+    pub score_ball: f64,
+    pub score_cage: f64,
+}
+
+/// The twin's latest fit. Topic `/twin/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TwinMessage {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    /// The fault hypothesis that fits best.
+    pub hypothesis: FaultKind,
+    pub error: f64,
+    pub margin: f64,
+    pub error_outer_race: f64,
+    pub error_inner_race: f64,
+    pub error_ball: f64,
+    pub a: f64,
+    pub decay_per_s: f64,
+    pub f_n: f64,
+    pub f_d: f64,
+    pub jitter: f64,
+    pub residual_energy_ratio: f64,
+    pub residual_peak_hz: f64,
+    /// Residual envelope spectrum (measured − twin) of the best hypothesis, amplitude per bin.
+    pub residual_bin_hz: f64,
+    pub residual: Vec<f32>,
+}
+
+/// A fault flag changed state. Topic `/flags/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FlagMessage {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    pub fault: FaultKind,
+    pub from: FlagLevel,
+    pub to: FlagLevel,
+    pub score: f64,
+    pub fault_frequency_hz: f64,
+}
+
+/// Something about the sensor or the bearing's life changed. Topic `/health/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HealthMessage {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    pub kind: HealthKind,
+    /// For [`HealthKind::Stage`]: the new stage.
+    pub stage: Option<HealthStage>,
+    pub detail: String,
+}
+
+/// The shaft speed a channel uses from `end_sample` on (every speed frame, every estimate).
+/// Topic `/speed/<sensor>/<axis>`. A replay feeds the measured ones (`source = "can"`) back at
+/// their samples, so its flags equal the live run's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpeedMessage {
+    pub channel: ChannelId,
+    /// The sample from which the speed applies.
+    pub end_sample: u64,
+    /// [`SpeedSource::Can`] (a speed frame) or [`SpeedSource::Estimate`].
+    pub source: SpeedSource,
+    /// The speed as given: the frame's value (`null`: "not available") or the estimate, rpm.
+    pub given_rpm: Option<f64>,
+    /// The speed the channel scores with from here; `null` when the given one is not usable
+    /// (not available, 0, above `max_rpm`): the channel then scores nothing.
+    pub rpm: Option<f64>,
+}
+
+/// Counters of one source since the daemon started, every `outputs.status_interval_s` and
+/// when the source stops. Topic `/ingest/<source>`, `<source>` `can-<interface>` or
+/// `shm-<sensor>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct IngestMessage {
+    pub source: String,
+    /// Frames received, valid or not.
+    pub frames: u64,
+    /// Samples delivered in blocks.
+    pub samples: u64,
+    pub gaps: u64,
+    /// Samples the nodes sent that never arrived (the gaps' sizes).
+    pub missing_samples: u64,
+    /// Frames refused (every kind; `bearingd ingest --json` shows them by kind).
+    pub malformed: u64,
+    pub restarts: u64,
+    /// Sample blocks of nodes or axes the config does not know, skipped.
+    pub dropped_blocks: u64,
+    pub speed_frames: u64,
+    pub sensor_lost: u64,
+    /// Transport batches dropped at a full hand-off queue (iceoryx2; also visible as gaps).
+    pub handoff_dropped: u64,
+}
+
+/// Everything the pipeline emits, in the order it emits it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum PipelineMessage {
+    Raw(RawBlock),
+    Spectrum(SpectrumMessage),
+    Indicators(IndicatorsMessage),
+    Twin(TwinMessage),
+    Flag(FlagMessage),
+    Health(HealthMessage),
+    Ingest(IngestMessage),
+    Speed(SpeedMessage),
+}
