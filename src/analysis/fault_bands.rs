@@ -243,7 +243,7 @@ impl FaultScorer {
         self.bin_hz = bin_hz;
         self.amplitude_len = amplitude.len();
         let lowest = freqs.bpfo.min(freqs.bpfi).min(freqs.two_bsf);
-        if amplitude.len() < 16 || !(bin_hz > 0.0) || !(lowest > 0.0) {
+        if amplitude.len() < 16 || !is_positive(bin_hz) || !is_positive(lowest) {
             return false;
         }
         let tiny = f32::MIN_POSITIVE;
@@ -384,7 +384,7 @@ impl FaultScorer {
         let spacing = fault.sideband_spacing(freqs).unwrap_or(0.0);
         let bin = self.bin_hz;
         let mut result = FaultScore::unscored(fault, freqs);
-        if !(f > 0.0) {
+        if !is_positive(f) {
             return result;
         }
         let (lines, count) = self.comb_lines(fault, freqs);
@@ -475,7 +475,7 @@ impl FaultScorer {
         self.masked.resize(n, false);
         let f = winner.frequency_hz;
         let bin = self.bin_hz;
-        if !(f > 0.0) {
+        if !is_positive(f) {
             return;
         }
         let shaft = freqs.shaft * (1.0 + winner.slip);
@@ -530,6 +530,11 @@ fn mark_line(masked: &mut [bool], at_hz: f64, harmonic_hz: f64, bin_hz: f64) {
     for m in masked.iter_mut().take(hi + 1).skip(lo) {
         *m = true;
     }
+}
+
+/// `x > 0` and a number (NaN is not).
+fn is_positive(x: f64) -> bool {
+    x.is_finite() && x > 0.0
 }
 
 /// The median of `values` (reordered in place); 0 for none.
