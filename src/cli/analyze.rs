@@ -27,7 +27,8 @@ pub enum BandMethod {
 
 #[derive(Args)]
 pub struct AnalyzeArgs {
-    /// Recordings: CWRU .mat, PRONOSTIA acc_*.csv, IMS text files, plain CSV or WAV.
+    /// Recordings: MATLAB .mat (CWRU, structs such as MFPT's), PRONOSTIA acc_*.csv, IMS text
+    /// files, plain CSV, WAV, or an MCAP log of bearingd run.
     #[arg(required_unless_present = "demo")]
     files: Vec<PathBuf>,
     /// Analyse a built-in simulated record (outer-race fault, SKF 6205-2RS, 1772 rpm, 12 kHz).
