@@ -6,6 +6,7 @@
 //! SKF 6205-2RS). Every assumption is written into the report's warnings; what cannot be
 //! resolved is an error that says which option gives it.
 
+use crate::analysis::iso::{record_severity, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::FaultKind;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
@@ -30,6 +31,8 @@ pub struct AnalyzeRequest {
     pub settings: AnalysisSettings,
     /// Also fit the signal-model twin for every fault hypothesis.
     pub twin: bool,
+    /// The machine group and foundation the ISO 10816-3 velocity zones are judged for.
+    pub severity: SeveritySettings,
 }
 
 /// Why a recording could not be analysed. Each message names the file and the fix.
@@ -285,6 +288,15 @@ pub fn analyze(
         warnings,
     };
     let mut report = AnalyzeReport::new(&context, &analysis, &request.settings);
+    // Velocity needs acceleration in physical units: a WAV file holds relative amplitudes.
+    if recording.format == RecordingFormat::Wav && !simulated {
+        report.warnings.push(
+            "no ISO 10816-3 velocity: a WAV file holds no scale to g; export the record in g (CSV, .mat) to get it".to_string(),
+        );
+    } else {
+        report.velocity =
+            record_severity(&mut analyzer.plans, &samples, fs_hz, rpm, request.severity);
+    }
     let twin = request.twin.then(|| {
         let band_of = |kind: FaultKind| {
             analysis

@@ -338,6 +338,32 @@ pub struct VelocitySeverity {
     pub per_bin_mm2_s2: Vec<f64>,
 }
 
+impl VelocitySeverity {
+    /// One line for people: the value, its zone and what the zone means, and the boundaries
+    /// it was judged against (the text report and the plot say the same).
+    pub fn summary(&self) -> String {
+        let l = &self.limits;
+        let rough = if self.low_edge_resolved {
+            ""
+        } else {
+            "; the record is too short to resolve the lower band limit, so the lowest part of the band is measured roughly"
+        };
+        format!(
+            "ISO 10816-3 velocity {:.2} mm/s RMS in {:.0}–{:.0} Hz: zone {} ({}); group {}, {} foundation: B from {}, C from {}, D from {} mm/s{rough}",
+            self.rms_mm_s,
+            self.band_hz[0],
+            self.band_hz[1],
+            self.zone.letter(),
+            self.zone.meaning(),
+            self.settings.group.number(),
+            self.settings.foundation.name(),
+            l.ab_mm_s,
+            l.bc_mm_s,
+            l.cd_mm_s
+        )
+    }
+}
+
 /// The velocity severity of `signal` (acceleration in g at `fs_hz`) of a machine turning at
 /// `rpm`. `None` when the record is shorter than 64 samples or the band lies above Nyquist.
 pub fn record_severity(

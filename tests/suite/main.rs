@@ -9,5 +9,6 @@ mod envelope;
 mod formats;
 mod kinematics;
 mod monitor;
+mod severity;
 mod speed;
 mod twin;
