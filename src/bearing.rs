@@ -31,6 +31,13 @@ pub enum BearingError {
     BadGeometry { text: String, problem: String },
 }
 
+/// Which race of a bearing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Race {
+    Outer,
+    Inner,
+}
+
 /// One catalog entry: names it answers to, and its geometry.
 struct CatalogEntry {
     names: &'static [&'static str],
@@ -73,6 +80,15 @@ const CATALOG: &[CatalogEntry] = &[
         z: 13,
         d_mm: 3.5,
         pitch_mm: 25.6,
+        alpha_deg: 0.0,
+    },
+    // MFPT data set (Society for Machinery Failure Prevention Technology): the NICE bearing,
+    // roller diameter 0.235 in, pitch diameter 1.245 in, 8 elements, contact angle 0.
+    CatalogEntry {
+        names: &["mfpt", "nice-mfpt"],
+        z: 8,
+        d_mm: 5.969,
+        pitch_mm: 31.623,
         alpha_deg: 0.0,
     },
     // IMS test rig.
@@ -199,6 +215,29 @@ impl BearingGeometry {
     /// Fault frequencies as multiples of the shaft rate (i.e. for `fr = 1 Hz`).
     pub fn fault_orders(&self) -> FaultFrequencies {
         self.fault_frequencies(1.0)
+    }
+
+    /// Radius of the path the rolling elements run on: the outer race `(D + d)/2` or the inner
+    /// race `(D − d)/2`, mm (MODELS.md §4).
+    pub fn race_radius_mm(&self, race: Race) -> f64 {
+        match race {
+            Race::Outer => (self.pitch_diameter_mm + self.element_diameter_mm) / 2.0,
+            Race::Inner => (self.pitch_diameter_mm - self.element_diameter_mm) / 2.0,
+        }
+    }
+
+    /// Time between the entry and the exit event of a race defect `length_mm` long, whose
+    /// impacts repeat at `fault_hz` (BPFO or BPFI): `Δt = Z·L / (2π r f_d)` (MODELS.md §4).
+    /// [`Self::defect_length_mm`] is its inverse.
+    pub fn entry_exit_delay_s(&self, race: Race, length_mm: f64, fault_hz: f64) -> f64 {
+        f64::from(self.rolling_elements) * length_mm
+            / (std::f64::consts::TAU * self.race_radius_mm(race) * fault_hz)
+    }
+
+    /// The defect length whose entry and exit are `delay_s` apart: `L = Δt·2π r f_d / Z`.
+    pub fn defect_length_mm(&self, race: Race, delay_s: f64, fault_hz: f64) -> f64 {
+        delay_s * std::f64::consts::TAU * self.race_radius_mm(race) * fault_hz
+            / f64::from(self.rolling_elements.max(1))
     }
 
     /// Fault frequencies at shaft rate `shaft_hz` (MODELS.md §1).

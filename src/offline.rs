@@ -6,6 +6,7 @@
 //! SKF 6205-2RS). Every assumption is written into the report's warnings; what cannot be
 //! resolved is an error that says which option gives it.
 
+use crate::analysis::iso::{record_severity, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
 use crate::bearing::{BearingError, BearingGeometry};
@@ -30,6 +31,8 @@ pub struct AnalyzeRequest {
     pub settings: AnalysisSettings,
     /// Also fit the signal-model twin for every fault hypothesis.
     pub twin: bool,
+    /// The machine group and foundation the ISO 10816-3 velocity zones are judged for.
+    pub severity: SeveritySettings,
 }
 
 /// Why a recording could not be analysed. Each message names the file and the fix.
@@ -69,29 +72,71 @@ pub struct AnalyzeOutcome {
 #[derive(Default)]
 struct DataSetFacts {
     rpm: Option<f64>,
-    bearing: Option<(&'static str, &'static str)>,
+    /// The bearing, and why it is assumed.
+    bearing: Option<(BearingGeometry, String)>,
+}
+
+/// A catalog bearing with the reason it is assumed.
+fn catalog(name: &str, why: &str) -> Option<(BearingGeometry, String)> {
+    BearingGeometry::from_catalog(name)
+        .ok()
+        .map(|b| (b, format!("{name} ({why})")))
+}
+
+/// `X105_DE_time` and the like: a CWRU variable of the drive end, fan end or base.
+fn is_cwru_channel(channel: &str) -> bool {
+    channel.starts_with('X')
+        && ["_DE_time", "_FE_time", "_BA_time"]
+            .iter()
+            .any(|s| channel.ends_with(s))
 }
 
 fn data_set_facts(recording: &Recording) -> DataSetFacts {
     match recording.format {
-        RecordingFormat::CwruMat if recording.channel.contains("_FE_") => DataSetFacts {
+        RecordingFormat::Matlab if is_cwru_channel(&recording.channel) => DataSetFacts {
             rpm: None,
-            bearing: Some(("skf-6203-2rs", "the CWRU fan-end bearing")),
+            bearing: if recording.channel.contains("_FE_") {
+                catalog("skf-6203-2rs", "the CWRU fan-end bearing")
+            } else {
+                catalog("skf-6205-2rs", "the CWRU drive-end bearing")
+            },
         },
-        RecordingFormat::CwruMat => DataSetFacts {
+        // The MFPT data set: struct `bearing` with the signal in `gs`.
+        RecordingFormat::Matlab if recording.channel == "bearing.gs" => DataSetFacts {
             rpm: None,
-            bearing: Some(("skf-6205-2rs", "the CWRU drive-end bearing")),
+            bearing: catalog("mfpt", "the MFPT data set's NICE bearing"),
         },
         RecordingFormat::PronostiaCsv => DataSetFacts {
             rpm: None,
-            bearing: Some(("pronostia", "the PRONOSTIA test bearing")),
+            bearing: catalog("pronostia", "the PRONOSTIA test bearing"),
         },
         RecordingFormat::ImsText => DataSetFacts {
             rpm: Some(2000.0),
-            bearing: Some(("rexnord-za-2115", "the IMS test rig's bearing")),
+            bearing: catalog("rexnord-za-2115", "the IMS test rig's bearing"),
         },
-        RecordingFormat::PlainCsv | RecordingFormat::Wav => DataSetFacts::default(),
+        RecordingFormat::McapLog => DataSetFacts {
+            rpm: None,
+            bearing: embedded_default_bearing(&recording.channel),
+        },
+        RecordingFormat::Matlab | RecordingFormat::PlainCsv | RecordingFormat::Wav => {
+            DataSetFacts::default()
+        }
     }
+}
+
+/// The bearing of sensor `sensor/axis` in the embedded default config, for logs of
+/// `bearingd run` without a config: the log does not record its bearing yet.
+fn embedded_default_bearing(channel: &str) -> Option<(BearingGeometry, String)> {
+    let sensor = channel.split('/').next()?;
+    let config = crate::config::Config::default_embedded().ok()?;
+    let found = config.sensors.into_iter().find(|s| s.id == sensor)?;
+    let name = found.bearing.name.clone();
+    Some((
+        found.bearing,
+        format!(
+            "{name}, the bearing of sensor '{sensor}' in the embedded default config: the log does not record its bearing"
+        ),
+    ))
 }
 
 /// Ten seconds of the twin's outer-race fault: needs no data and no hardware.
@@ -136,7 +181,7 @@ pub fn resolve_conditions(
     let facts = if simulated {
         DataSetFacts {
             rpm: None,
-            bearing: Some(("skf-6205-2rs", "the simulated bearing")),
+            bearing: catalog("skf-6205-2rs", "the simulated bearing"),
         }
     } else {
         data_set_facts(recording)
@@ -181,11 +226,10 @@ pub fn resolve_conditions(
     let mut warnings = recording.warnings.clone();
     let bearing = match (&request.bearing, facts.bearing) {
         (Some(text), _) => BearingGeometry::parse(text)?,
-        (None, Some((name, why))) => {
-            let bearing = BearingGeometry::from_catalog(name)?;
+        (None, Some((bearing, why))) => {
             if !simulated {
                 warnings.push(format!(
-                    "bearing not given: assumed {name} ({why}); give --bearing to change"
+                    "bearing not given: assumed {why}; give --bearing to change"
                 ));
             }
             bearing
@@ -244,6 +288,15 @@ pub fn analyze(
         warnings,
     };
     let mut report = AnalyzeReport::new(&context, &analysis, &request.settings);
+    // Velocity needs acceleration in physical units: a WAV file holds relative amplitudes.
+    if recording.format == RecordingFormat::Wav && !simulated {
+        report.warnings.push(
+            "no ISO 10816-3 velocity: a WAV file holds no scale to g; export the record in g (CSV, .mat) to get it".to_string(),
+        );
+    } else {
+        report.velocity =
+            record_severity(&mut analyzer.plans, &samples, fs_hz, rpm, request.severity);
+    }
     let twin = request.twin.then(|| {
         let band_of = |kind: FaultKind| {
             analysis

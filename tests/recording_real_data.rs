@@ -28,7 +28,7 @@ fn every_cwru_file_matches_its_manifest_row() {
         let path = dir.join(&row["file"]);
         let r = read_recording(&path, &ReadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
         let what = &row["file"];
-        assert_eq!(r.format, RecordingFormat::CwruMat);
+        assert_eq!(r.format, RecordingFormat::Matlab);
         assert_eq!(r.channel, row["channel_var"], "{what}");
         assert_eq!(
             r.samples.len(),

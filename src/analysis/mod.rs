@@ -12,6 +12,7 @@
 //! - [`indicators`]: RMS, peak, crest factor, kurtosis.
 //! - [`record`]: all of the above over one whole record (`bearingd analyze`).
 //! - [`speed`]: the shaft speed estimated from the spectrum near a nominal speed.
+//! - [`iso`]: velocity severity and zones after ISO 10816-3 / 20816-3.
 
 pub mod band;
 pub mod diagnosis;
@@ -20,6 +21,7 @@ pub mod fault_bands;
 pub mod flags;
 pub mod health;
 pub mod indicators;
+pub mod iso;
 pub mod kurtogram;
 pub mod monitor;
 pub mod record;

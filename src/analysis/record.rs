@@ -334,7 +334,30 @@ fn record_window(
     {
         window /= 2;
     }
-    window
+    window.min(short_record_window(len, fs_hz, freqs))
+}
+
+/// Bins the lowest fault frequency must lie above 0 Hz in a short record's spectrum: the Hann
+/// window's main lobe spans ±2 bins, so 4 keeps the first harmonic clear of the DC lobe.
+const MIN_LINE_BINS: f64 = 4.0;
+
+/// (choice) A record shorter than the configured window (a 0.1 s PRONOSTIA snapshot) is
+/// analysed as one window of the largest power of two it holds: the finest resolution the
+/// record allows (2,048 of 2,560 samples at 25.6 kHz: bins of 12.5 Hz), provided the lowest
+/// fault frequency sits at least [`MIN_LINE_BINS`] bins above 0 Hz; otherwise the window that
+/// needs (longer than the record: the caller reports the record as too short). For a record
+/// that holds the configured window this is never the smaller one.
+fn short_record_window(len: usize, fs_hz: f64, freqs: &FaultFrequencies) -> usize {
+    let lowest_hz = freqs.bpfo.min(freqs.bpfi).min(freqs.two_bsf);
+    let needed = (MIN_LINE_BINS * fs_hz / lowest_hz)
+        .ceil()
+        .clamp(64.0, (1u64 << 30) as f64) as usize;
+    let fitting = if len >= 1 { 1usize << len.ilog2() } else { 0 };
+    if fitting >= needed {
+        fitting
+    } else {
+        needed.next_power_of_two()
+    }
 }
 
 fn best_index(scan: &BandScan, use_gk: bool) -> usize {

@@ -1,6 +1,7 @@
 //! `bearingd analyze FILE...`: diagnose recordings and show the evidence.
 
 use super::{CliError, RecordingArgs};
+use crate::analysis::iso::{Foundation, MachineGroup, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisSettings, BandSelection};
 use crate::offline::{analyze, AnalyzeRequest};
@@ -27,7 +28,8 @@ pub enum BandMethod {
 
 #[derive(Args)]
 pub struct AnalyzeArgs {
-    /// Recordings: CWRU .mat, PRONOSTIA acc_*.csv, IMS text files, plain CSV or WAV.
+    /// Recordings: MATLAB .mat (CWRU, structs such as MFPT's), PRONOSTIA acc_*.csv, IMS text
+    /// files, plain CSV, WAV, or an MCAP log of bearingd run.
     #[arg(required_unless_present = "demo")]
     files: Vec<PathBuf>,
     /// Analyse a built-in simulated record (outer-race fault, SKF 6205-2RS, 1772 rpm, 12 kHz).
@@ -61,6 +63,33 @@ pub struct AnalyzeArgs {
     /// twin's spectrum to the text and the plot).
     #[arg(long)]
     twin: bool,
+    /// ISO 10816-3 machine group for the velocity zones: 1 (above 300 kW, or shaft height
+    /// from 315 mm) or 2 (15 to 300 kW, shaft height 160 to 315 mm).
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
+    machine_group: u8,
+    /// Foundation for the velocity zones: rigid or flexible.
+    #[arg(long, value_enum, default_value = "rigid")]
+    foundation: FoundationArg,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum FoundationArg {
+    Rigid,
+    Flexible,
+}
+
+fn severity_from(args: &AnalyzeArgs) -> SeveritySettings {
+    SeveritySettings {
+        group: if args.machine_group == 1 {
+            MachineGroup::Large
+        } else {
+            MachineGroup::Medium
+        },
+        foundation: match args.foundation {
+            FoundationArg::Rigid => Foundation::Rigid,
+            FoundationArg::Flexible => Foundation::Flexible,
+        },
+    }
 }
 
 pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
@@ -85,6 +114,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
             bearing: args.recording.bearing.clone(),
             settings: settings.clone(),
             twin: args.twin,
+            severity: severity_from(args),
         };
         let outcome = match analyze(&request, &mut analyzer) {
             Ok(outcome) => outcome,

@@ -21,7 +21,8 @@ use std::process::ExitCode;
 /// How to read a recording and what it was taken under: shared by `analyze` and `import`.
 #[derive(Args)]
 pub struct RecordingArgs {
-    /// Channel: DE, FE, BA or a variable (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS).
+    /// Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat);
+    /// horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log).
     #[arg(long)]
     pub channel: Option<String>,
     /// Column of a CSV table: header name or 1-based index.

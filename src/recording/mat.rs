@@ -1,266 +1,142 @@
-//! MATLAB v5 `.mat` files, read with the CWRU conventions.
+//! MATLAB `.mat` files (v5 to v7.2, and `scipy.io.savemat`): which array is the signal, and
+//! what the file says about its sample rate and shaft speed.
 //!
-//! CWRU files hold column vectors `XNNN_DE_time`, `XNNN_FE_time`, `XNNN_BA_time` (drive end,
-//! fan end, base; g) and `XNNNRPM` (measured shaft speed), NNN being the CWRU record number,
-//! which the file name repeats at its end (`…_105.mat`). Some files also carry another record's
-//! variables, so the default channel is the drive-end variable of the file's own record, never
-//! "the first one found".
+//! The format itself is decoded by [`super::mat5`] into a tree of variables; this module
+//! flattens it into numeric arrays named by their path (`bearing.gs`, `s(2).x`, `c{1}`) and
+//! applies two sets of conventions:
 //!
-//! Decoding is done by `matfile`, but not trusted blindly: it can panic on odd input and it
-//! silently drops a variable cut off by the end of the file. So this module checks the header and
-//! walks the top-level data elements itself first (a truncated file is reported with byte
-//! counts), then hands `matfile` one element at a time under `catch_unwind`. An element that
-//! cannot be decoded is skipped with a warning and shown as such in variable lists.
+//! - **CWRU**: column vectors `XNNN_DE_time`, `XNNN_FE_time`, `XNNN_BA_time` (drive end, fan
+//!   end, base; g) and `XNNNRPM` (measured shaft speed), NNN being the CWRU record number,
+//!   which the file name repeats at its end (`…_105.mat`). Some files also carry another
+//!   record's variables, so the default channel is the drive-end variable of the file's own
+//!   record, never "the first one found". The rate comes from the file-name prefix.
+//! - **Everything else** (the MFPT set's struct `bearing` with `gs`, `sr`, `rate`, `load`; a
+//!   file saved as `save(f, 'x', 'fs')`): without `--channel`, the one vector of samples in
+//!   the file; with several, an error listing them. The sample rate and the shaft speed come
+//!   from scalars named as below, looked up beside the signal, then in each enclosing struct
+//!   out to the top level (nearest first):
+//!   - sample rate in Hz: `fs`, `sr`, `fs_hz`, `sample_rate`, `sample_rate_hz`,
+//!     `sampling_rate`, `samplerate`, `sampling_frequency`;
+//!   - shaft speed in rpm: `rpm`, `speed_rpm`, `shaft_rpm`;
+//!   - shaft speed in Hz: `shaft_hz`, `fr`, and `rate` when a sample rate `sr` sits beside it
+//!     (the MFPT convention: `rate` is the shaft rate; a warning says it was read so).
+//!
+//! Every name is matched without regard to case.
 
+use super::mat5::{self, dims_text, NumericArray, Value};
 use super::{file_name, Recording, RecordingError, RecordingFormat};
-use std::ops::Range;
-use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
-const MAGIC: &[u8] = b"MATLAB 5.0 MAT-file";
-const HEADER_LEN: usize = 128;
-const MI_MATRIX: u32 = 14;
-const MI_COMPRESSED: u32 = 15;
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Endian {
-    Little,
-    Big,
+/// A numeric array of the file, named by its path.
+struct Leaf<'a> {
+    path: String,
+    array: &'a NumericArray,
 }
 
-fn u32_at(bytes: &[u8], at: usize, endian: Endian) -> Option<u32> {
-    let b: [u8; 4] = bytes.get(at..at.checked_add(4)?)?.try_into().ok()?;
-    Some(match endian {
-        Endian::Little => u32::from_le_bytes(b),
-        Endian::Big => u32::from_be_bytes(b),
-    })
-}
+impl Leaf<'_> {
+    /// The path of the struct holding it (`""` at top level).
+    fn parent(&self) -> &str {
+        self.path.rfind('.').map_or("", |i| &self.path[..i])
+    }
 
-/// Checks the 128-byte header: text starting with `MATLAB 5.0 MAT-file`, version 0x0100,
-/// endian indicator `IM` or `MI`.
-fn check_header(path: &Path, bytes: &[u8]) -> Result<Endian, RecordingError> {
-    let not_matlab = |reason: String| RecordingError::NotMatlab {
-        path: path.to_path_buf(),
-        reason,
-    };
-    let n = bytes.len().min(MAGIC.len());
-    if bytes[..n] != MAGIC[..n] {
-        let reason = if bytes.starts_with(b"MATLAB 7.3") {
-            "it is a MATLAB 7.3 (HDF5) file; save it again in MATLAB with save(file, '-v7')"
-                .to_string()
-        } else if bytes.starts_with(b"RIFF") {
-            "it starts like a WAV file; rename it to .wav".to_string()
-        } else {
-            let start: String = String::from_utf8_lossy(&bytes[..bytes.len().min(24)])
-                .chars()
-                .map(|c| if c.is_control() { ' ' } else { c })
-                .collect();
-            format!(
-                "it starts with \"{}\" instead of \"MATLAB 5.0 MAT-file\"; check that it is the right file (a .mat from MATLAB 5 to 7.2)",
-                start.trim_end()
-            )
-        };
-        return Err(not_matlab(reason));
+    /// Its own name, the last path component.
+    fn field(&self) -> &str {
+        self.path
+            .rfind('.')
+            .map_or(self.path.as_str(), |i| &self.path[i + 1..])
     }
-    if bytes.len() < HEADER_LEN {
-        return Err(RecordingError::Truncated {
-            path: path.to_path_buf(),
-            what: "the MATLAB header".to_string(),
-            expected: HEADER_LEN as u64,
-            present: bytes.len() as u64,
-        });
+
+    fn is_vector(&self) -> bool {
+        self.array.real.len() > 1 && self.array.dims.iter().filter(|&&d| d > 1).count() == 1
     }
-    let endian = match &bytes[126..128] {
-        b"IM" => Endian::Little,
-        b"MI" => Endian::Big,
-        other => {
-            return Err(not_matlab(format!(
-                "the endian indicator at byte 126 is {other:?}, not \"IM\" or \"MI\"; the header is damaged"
-            )))
+
+    fn scalar(&self) -> Option<f64> {
+        match (self.array.real.as_slice(), self.array.complex) {
+            ([v], false) => Some(*v),
+            _ => None,
         }
-    };
-    let version = match endian {
-        Endian::Little => u16::from_le_bytes([bytes[124], bytes[125]]),
-        Endian::Big => u16::from_be_bytes([bytes[124], bytes[125]]),
-    };
-    if version != 0x0100 {
-        return Err(not_matlab(format!(
-            "the header gives version 0x{version:04x}, not 0x0100; save it again in MATLAB with save(file, '-v7')"
-        )));
     }
-    Ok(endian)
 }
 
-/// A top-level data element: where it starts and the bytes it covers (tag included).
-struct Element {
-    offset: usize,
-    bytes: Range<usize>,
-    compressed: bool,
-}
-
-/// Walks the top-level data elements, checking that each fits in the file.
-fn elements(
-    path: &Path,
-    bytes: &[u8],
-    endian: Endian,
-    warnings: &mut Vec<String>,
-) -> Result<Vec<Element>, RecordingError> {
-    let truncated = |what: String, expected: usize| RecordingError::Truncated {
-        path: path.to_path_buf(),
-        what,
-        expected: expected as u64,
-        present: bytes.len() as u64,
-    };
-    let mut out = Vec::new();
-    let mut off = HEADER_LEN;
-    while off < bytes.len() {
-        let (Some(kind), Some(size)) = (u32_at(bytes, off, endian), u32_at(bytes, off + 4, endian))
-        else {
-            return Err(truncated(
-                format!("the data element tag at byte {off}"),
-                off + 8,
-            ));
-        };
-        if kind & 0xFFFF_0000 != 0 {
-            return Err(RecordingError::DamagedMat {
-                path: path.to_path_buf(),
-                detail: format!("the data element tag at byte {off} is not valid here"),
-            });
-        }
-        let end = off.saturating_add(8).saturating_add(size as usize);
-        if end > bytes.len() {
-            let what = match element_header(&bytes[off..], endian) {
-                Some(h) if kind == MI_MATRIX => format!("variable '{}' (at byte {off})", h.name),
-                _ => format!("the data element at byte {off}"),
-            };
-            return Err(truncated(what, end));
-        }
-        match kind {
-            MI_MATRIX | MI_COMPRESSED => out.push(Element {
-                offset: off,
-                bytes: off..end,
-                compressed: kind == MI_COMPRESSED,
-            }),
-            _ => warnings.push(format!(
-                "skipped a data element of type {kind} at byte {off}: not a variable"
-            )),
-        }
-        // Uncompressed elements are padded to 8 bytes; compressed ones are not.
-        off = if kind == MI_COMPRESSED {
-            end
-        } else {
-            end.checked_next_multiple_of(8).unwrap_or(end)
-        };
-    }
-    Ok(out)
-}
-
-/// What an uncompressed matrix element says about itself, read straight from its bytes: its
-/// name (for messages about elements `matfile` cannot decode) and whether its dimensions fit
-/// in an `i32` product (`matfile` multiplies them unchecked, which panics in debug builds).
-struct ElementHeader {
-    name: String,
-    dims_ok: bool,
-}
-
-fn element_header(el: &[u8], endian: Endian) -> Option<ElementHeader> {
-    // Tag (8), array flags (16), then the dimensions and the name sub-elements.
-    let mut at = 24;
-    let mut parts = [(0usize, 0usize); 2];
-    for part in &mut parts {
-        let tag = u32_at(el, at, endian)?;
-        let (data_at, len, next) = if tag & 0xFFFF_0000 != 0 {
-            (at + 4, (tag >> 16) as usize, at + 8)
-        } else {
-            let len = u32_at(el, at + 4, endian)? as usize;
-            let next = at.checked_add(len.checked_next_multiple_of(8)?.checked_add(8)?)?;
-            (at + 8, len, next)
-        };
-        *part = (data_at, len);
-        at = next;
-    }
-    let [(dims_at, dims_len), (name_at, name_len)] = parts;
-    let name = el.get(name_at..name_at.checked_add(name_len)?)?;
-    let dims_ok = (0..dims_len / 4)
-        .map(|k| u32_at(el, dims_at.checked_add(4 * k)?, endian).map(|d| d as i32))
-        .try_fold(1i32, |acc, d| acc.checked_mul(d?).filter(|p| *p >= 0))
-        .is_some();
-    Some(ElementHeader {
-        name: String::from_utf8_lossy(name).into_owned(),
-        dims_ok,
-    })
-}
-
-/// What a file holds: the numeric arrays, and descriptions of the variables that are not.
-struct Contents {
-    arrays: Vec<matfile::Array>,
+/// What a file holds: its numeric arrays by path, descriptions of everything else.
+struct Contents<'a> {
+    leaves: Vec<Leaf<'a>>,
     others: Vec<String>,
-    warnings: Vec<String>,
 }
 
-impl Contents {
+impl Contents<'_> {
     /// Everything, for error messages.
     fn listing(&self) -> Vec<String> {
-        let mut all: Vec<String> = self.arrays.iter().map(|a| a.name().to_string()).collect();
+        let mut all: Vec<String> = self.leaves.iter().map(|l| l.path.clone()).collect();
         all.extend(self.others.iter().cloned());
         all
     }
+
+    /// The vectors of samples, for "which one?" messages.
+    fn vectors(&self) -> Vec<String> {
+        self.leaves
+            .iter()
+            .filter(|l| l.is_vector())
+            .map(|l| format!("{} ({})", l.path, dims_text(&l.array.dims)))
+            .collect()
+    }
 }
 
-fn decode(path: &Path, bytes: &[u8]) -> Result<Contents, RecordingError> {
-    let endian = check_header(path, bytes)?;
-    let mut warnings = Vec::new();
-    let elements = elements(path, bytes, endian, &mut warnings)?;
-    let mut arrays = Vec::new();
-    let mut others = Vec::new();
-    for el in elements {
-        let mut buf = Vec::with_capacity(HEADER_LEN + el.bytes.len());
-        buf.extend_from_slice(&bytes[..HEADER_LEN]);
-        buf.extend_from_slice(&bytes[el.bytes.clone()]);
-        let header = element_header(&bytes[el.bytes.clone()], endian).filter(|_| !el.compressed);
-        let what = match &header {
-            Some(h) => format!("'{}'", h.name),
-            None => format!("at byte {}", el.offset),
-        };
-        if header.as_ref().is_some_and(|h| !h.dims_ok) {
-            warnings.push(format!(
-                "skipped the variable {what}: its dimensions are invalid"
-            ));
-            others.push(format!("{what} (cannot be decoded)"));
-            continue;
-        }
-        match catch_unwind(AssertUnwindSafe(|| matfile::MatFile::parse(buf.as_slice()))) {
-            Ok(Ok(file)) if !file.arrays().is_empty() => {
-                arrays.extend(file.arrays().iter().cloned())
-            }
-            Ok(Ok(_)) => others.push(format!("{what} (not a numeric array)")),
-            Ok(Err(e)) => {
-                warnings.push(format!(
-                    "skipped the variable {what}: it cannot be decoded ({e})"
-                ));
-                others.push(format!("{what} (cannot be decoded)"));
-            }
-            Err(_) => {
-                warnings.push(format!(
-                    "skipped the variable {what}: the MATLAB decoder failed on it (internal panic)"
-                ));
-                others.push(format!("{what} (cannot be decoded)"));
-            }
-        }
+fn contents(file: &mat5::MatFile) -> Contents<'_> {
+    let mut out = Contents {
+        leaves: Vec::new(),
+        others: Vec::new(),
+    };
+    for var in &file.variables {
+        flatten(&var.value, var.name.clone(), &mut out);
     }
-    Ok(Contents {
-        arrays,
-        others,
-        warnings,
-    })
+    out.others.extend(file.undecodable.iter().cloned());
+    out
+}
+
+/// `s` for a 1x1 struct, `s(k)` (1-based, column-major) for element k of a struct array.
+fn element_path(path: &str, k: usize, count: usize) -> String {
+    if count == 1 {
+        path.to_string()
+    } else {
+        format!("{path}({})", k + 1)
+    }
+}
+
+fn flatten<'a>(value: &'a Value, path: String, out: &mut Contents<'a>) {
+    match value {
+        Value::Numeric(array) => out.leaves.push(Leaf { path, array }),
+        Value::Struct(s) => {
+            for (k, element) in s.elements.iter().enumerate() {
+                let base = element_path(&path, k, s.elements.len());
+                for (field, value) in s.fields.iter().zip(element) {
+                    flatten(value, format!("{base}.{field}"), out);
+                }
+            }
+            if s.elements.is_empty() {
+                out.others.push(format!("{path} (empty struct)"));
+            }
+        }
+        Value::Cell(cells) => {
+            for (k, value) in cells.iter().enumerate() {
+                flatten(value, format!("{path}{{{}}}", k + 1), out);
+            }
+        }
+        Value::Other { dims, kind } if dims.is_empty() => {
+            out.others.push(format!("{path} ({kind})"))
+        }
+        Value::Other { dims, kind } => out
+            .others
+            .push(format!("{path} ({} {kind})", dims_text(dims))),
+    }
 }
 
 pub(super) fn channels(path: &Path, bytes: &[u8]) -> Result<Vec<String>, RecordingError> {
-    let contents = decode(path, bytes)?;
-    Ok(contents
-        .arrays
+    let file = mat5::parse(path, bytes)?;
+    Ok(contents(&file)
+        .leaves
         .iter()
-        .map(|a| a.name().to_string())
+        .map(|l| l.path.clone())
         .collect())
 }
 
@@ -326,16 +202,16 @@ fn fs_from_name(path: &Path) -> Option<f64> {
 /// file name, else the only one of that kind, else an error.
 fn by_kind(
     path: &Path,
-    contents: &Contents,
+    contents: &Contents<'_>,
     kind: Kind,
     warnings: &mut Vec<String>,
 ) -> Result<usize, RecordingError> {
     let record = file_record(path);
     let candidates: Vec<(usize, u32)> = contents
-        .arrays
+        .leaves
         .iter()
         .enumerate()
-        .filter_map(|(i, a)| match cwru_name(a.name()) {
+        .filter_map(|(i, a)| match cwru_name(&a.path) {
             Some((r, k)) if k == kind => Some((i, r)),
             _ => None,
         })
@@ -372,27 +248,45 @@ fn by_kind(
     }
 }
 
+/// The default channel of a file that is not CWRU's: its one vector of samples.
+fn only_vector(path: &Path, contents: &Contents<'_>) -> Result<usize, RecordingError> {
+    let vectors: Vec<usize> = (0..contents.leaves.len())
+        .filter(|&i| contents.leaves[i].is_vector())
+        .collect();
+    match vectors.as_slice() {
+        [i] => Ok(*i),
+        [] if contents.leaves.len() == 1 => Ok(0),
+        [] => Err(RecordingError::NoSignal {
+            path: path.to_path_buf(),
+            present: contents.listing(),
+        }),
+        _ => Err(RecordingError::AmbiguousVariable {
+            path: path.to_path_buf(),
+            problem: format!("{} vectors of samples", vectors.len()),
+            present: contents.vectors(),
+        }),
+    }
+}
+
 fn choose(
     path: &Path,
-    contents: &Contents,
+    contents: &Contents<'_>,
     selector: Option<&str>,
     warnings: &mut Vec<String>,
 ) -> Result<usize, RecordingError> {
-    let names: Vec<&str> = contents.arrays.iter().map(|a| a.name()).collect();
+    let names: Vec<&str> = contents.leaves.iter().map(|l| l.path.as_str()).collect();
+    let cwru = names.iter().any(|n| cwru_name(n).is_some());
     let Some(wanted) = selector else {
-        // A non-CWRU file with a single variable has nothing to choose from.
-        let no_de = names
-            .iter()
-            .all(|n| !matches!(cwru_name(n), Some((_, Kind::DriveEnd))));
-        if no_de && names.len() == 1 {
-            return Ok(0);
-        }
-        return by_kind(path, contents, Kind::DriveEnd, warnings);
+        return if cwru {
+            by_kind(path, contents, Kind::DriveEnd, warnings)
+        } else {
+            only_vector(path, contents)
+        };
     };
     if let Some(i) = names.iter().position(|n| *n == wanted) {
         return Ok(i);
     }
-    if let Some(kind) = Kind::keyword(wanted) {
+    if let Some(kind) = Kind::keyword(wanted).filter(|_| cwru) {
         return by_kind(path, contents, kind, warnings);
     }
     if let Some(i) = names.iter().position(|n| n.eq_ignore_ascii_case(wanted)) {
@@ -405,56 +299,120 @@ fn choose(
     })
 }
 
-/// The real values of an array as f64, or why not.
-fn values(array: &matfile::Array) -> Result<Vec<f64>, &'static str> {
-    macro_rules! convert {
-        ($($variant:ident),*) => {
-            match array.data() {
-                $(matfile::NumericData::$variant { real, imag: None } => {
-                    Ok(real.iter().map(|&v| v as f64).collect())
-                })*
-                _ => Err("is complex"),
-            }
-        };
-    }
-    convert!(Double, Single, Int8, UInt8, Int16, UInt16, Int32, UInt32, Int64, UInt64)
-}
-
-/// The samples of the chosen variable: it must be a real vector.
-fn vector(path: &Path, array: &matfile::Array) -> Result<Vec<f64>, RecordingError> {
+/// The samples of the chosen array: it must be a real vector.
+fn vector(path: &Path, leaf: &Leaf<'_>) -> Result<Vec<f64>, RecordingError> {
     let unsupported = |problem: String| RecordingError::UnsupportedVariable {
         path: path.to_path_buf(),
-        name: array.name().to_string(),
+        name: leaf.path.clone(),
         problem,
     };
-    let size = array.size();
-    if size.iter().filter(|&&d| d > 1).count() > 1 {
-        let dims: Vec<String> = size.iter().map(|d| d.to_string()).collect();
+    let dims = &leaf.array.dims;
+    if dims.iter().filter(|&&d| d > 1).count() > 1 {
         return Err(unsupported(format!(
             "is a {} matrix, not a vector",
-            dims.join("x")
+            dims_text(dims)
         )));
     }
-    values(array).map_err(|p| unsupported(p.to_string()))
+    if leaf.array.complex {
+        return Err(unsupported("is complex".to_string()));
+    }
+    Ok(leaf.array.real.clone())
 }
 
 /// The shaft speed from `XNNNRPM` of the chosen variable's record, when present and sensible.
-fn rpm(contents: &Contents, channel: &str, warnings: &mut Vec<String>) -> Option<f64> {
+fn cwru_rpm(contents: &Contents<'_>, channel: &str, warnings: &mut Vec<String>) -> Option<f64> {
     let (record, _) = cwru_name(channel)?;
-    let array = contents
-        .arrays
+    let leaf = contents
+        .leaves
         .iter()
-        .find(|a| cwru_name(a.name()) == Some((record, Kind::Rpm)))?;
-    match values(array).ok().and_then(|v| v.first().copied()) {
-        Some(v) if v.is_finite() && v > 0.0 => Some(v),
+        .find(|l| cwru_name(&l.path) == Some((record, Kind::Rpm)))?;
+    match leaf.array.real.first().copied() {
+        Some(v) if v.is_finite() && v > 0.0 && !leaf.array.complex => Some(v),
         _ => {
             warnings.push(format!(
                 "variable {} does not hold a positive speed; rpm unknown",
-                array.name()
+                leaf.path
             ));
             None
         }
     }
+}
+
+const RATE_NAMES: [&str; 8] = [
+    "fs",
+    "sr",
+    "fs_hz",
+    "sample_rate",
+    "sample_rate_hz",
+    "sampling_rate",
+    "samplerate",
+    "sampling_frequency",
+];
+const RPM_NAMES: [&str; 3] = ["rpm", "speed_rpm", "shaft_rpm"];
+const SHAFT_HZ_NAMES: [&str; 2] = ["shaft_hz", "fr"];
+
+/// The scalar named one of `names` nearest to the chosen signal: beside it, then in each
+/// enclosing struct out to the top level.
+fn nearest_scalar<'c>(
+    contents: &'c Contents<'_>,
+    chosen: &Leaf<'_>,
+    names: &[&str],
+) -> Option<(&'c Leaf<'c>, f64)> {
+    let home = chosen.parent();
+    contents
+        .leaves
+        .iter()
+        .filter(|l| names.iter().any(|n| l.field().eq_ignore_ascii_case(n)))
+        .filter(|l| {
+            let p = l.parent();
+            p.is_empty() || home == p || home.starts_with(&format!("{p}."))
+        })
+        .filter_map(|l| l.scalar().map(|v| (l, v)))
+        .max_by_key(|(l, _)| l.parent().len())
+}
+
+/// Sample rate and shaft speed a non-CWRU file states beside its signal (see the module docs).
+fn stated_conditions(
+    contents: &Contents<'_>,
+    chosen: &Leaf<'_>,
+    warnings: &mut Vec<String>,
+) -> (Option<f64>, Option<f64>) {
+    let usable = |what: &str, leaf: &Leaf<'_>, v: f64, warnings: &mut Vec<String>| {
+        if v.is_finite() && v > 0.0 {
+            Some(v)
+        } else {
+            warnings.push(format!(
+                "{} = {v} is not a usable {what}; ignored",
+                leaf.path
+            ));
+            None
+        }
+    };
+    let fs = nearest_scalar(contents, chosen, &RATE_NAMES)
+        .and_then(|(l, v)| usable("sample rate", l, v, warnings));
+    let rpm = if let Some((l, v)) = nearest_scalar(contents, chosen, &RPM_NAMES) {
+        usable("speed in rpm", l, v, warnings)
+    } else if let Some((l, v)) = nearest_scalar(contents, chosen, &SHAFT_HZ_NAMES) {
+        usable("shaft speed in Hz", l, v, warnings).map(|hz| hz * 60.0)
+    } else {
+        // MFPT: `rate` (shaft Hz) beside `sr` (sample rate).
+        nearest_scalar(contents, chosen, &["rate"])
+            .filter(|(l, _)| {
+                contents.leaves.iter().any(|s| {
+                    s.parent() == l.parent() && s.field().eq_ignore_ascii_case("sr")
+                })
+            })
+            .and_then(|(l, v)| {
+                let hz = usable("shaft speed in Hz", l, v, warnings)?;
+                warnings.push(format!(
+                    "shaft speed read from {} = {hz} as a shaft rate in Hz ({} rpm), the MFPT data set's convention; give --rpm if that is not what it means",
+                    l.path,
+                    hz * 60.0
+                ));
+                Some(hz * 60.0)
+            })
+    };
+    (fs, rpm)
 }
 
 pub(super) fn read(
@@ -462,17 +420,25 @@ pub(super) fn read(
     bytes: &[u8],
     selector: Option<&str>,
 ) -> Result<Recording, RecordingError> {
-    let contents = decode(path, bytes)?;
-    let mut warnings = contents.warnings.clone();
+    let file = mat5::parse(path, bytes)?;
+    let contents = contents(&file);
+    let mut warnings = file.warnings.clone();
     let index = choose(path, &contents, selector, &mut warnings)?;
-    let array = &contents.arrays[index];
-    let samples = vector(path, array)?;
-    let rpm = rpm(&contents, array.name(), &mut warnings);
+    let leaf = &contents.leaves[index];
+    let samples = vector(path, leaf)?;
+    let (fs_hz, rpm) = if cwru_name(&leaf.path).is_some() {
+        (
+            fs_from_name(path),
+            cwru_rpm(&contents, &leaf.path, &mut warnings),
+        )
+    } else {
+        stated_conditions(&contents, leaf, &mut warnings)
+    };
     Ok(Recording {
         path: path.to_path_buf(),
-        format: RecordingFormat::CwruMat,
-        channel: array.name().to_string(),
-        fs_hz: fs_from_name(path),
+        format: RecordingFormat::Matlab,
+        channel: leaf.path.clone(),
+        fs_hz,
         rpm,
         samples,
         warnings,

@@ -1,5 +1,6 @@
-//! Readers for recorded vibration data: CWRU MATLAB v5 `.mat`, PRONOSTIA `acc_NNNNN.csv`,
-//! IMS snapshot text files, plain CSV tables and WAV.
+//! Readers for recorded vibration data: MATLAB `.mat` (CWRU's vectors, structs such as the
+//! MFPT set's), PRONOSTIA `acc_NNNNN.csv`, IMS snapshot text files, plain CSV tables, WAV, and
+//! the MCAP logs `bearingd run` writes.
 //!
 //! Why this module exists: every data set stores its samples differently, and each one also
 //! says something about itself (sampling rate, shaft speed, which channel is which) in a
@@ -11,12 +12,14 @@
 //! [`Recording::warnings`]. Nothing is guessed silently.
 //!
 //! Every error is one line that names the file, the problem and how to fix it. No input, however
-//! damaged, makes a reader panic (the third-party MATLAB and WAV parsers run under
-//! `catch_unwind` as a backstop).
+//! damaged, makes a reader panic (the MATLAB decoder is our own and bounds-checked; the
+//! third-party WAV parser runs under `catch_unwind` as a backstop).
 
 mod csv;
 mod ims;
 mod mat;
+mod mat5;
+mod mcap;
 mod text;
 mod wav;
 
@@ -30,12 +33,14 @@ pub struct Recording {
     pub path: PathBuf,
     /// How the file was read.
     pub format: RecordingFormat,
-    /// The channel read, as the file names it: `X105_DE_time`, `horizontal`, `B3x`, a CSV
-    /// header name or `column 3`, or the 1-based WAV channel `1`.
+    /// The channel read, as the file names it: `X105_DE_time`, `bearing.gs`, `horizontal`,
+    /// `B3x`, a CSV header name or `column 3`, the 1-based WAV channel `1`, or an MCAP log's
+    /// `sensor/axis`.
     pub channel: String,
     /// Sampling rate, when the format or the file name states it; `None` when unknown.
     pub fs_hz: Option<f64>,
-    /// Shaft speed, when the file states it (the CWRU `XNNNRPM` variable); `None` otherwise.
+    /// Shaft speed, when the file states it (the CWRU `XNNNRPM` variable, a MATLAB `rpm` or
+    /// `rate` scalar, an MCAP log's speed topic); `None` otherwise.
     pub rpm: Option<f64>,
     /// The samples, all finite: acceleration in g for the data-set formats; for WAV, full-scale
     /// units (see [`RecordingFormat::Wav`]).
@@ -47,10 +52,12 @@ pub struct Recording {
 /// The file formats this module reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum RecordingFormat {
-    /// MATLAB v5 `.mat`, read with the CWRU naming rules (`XNNN_DE_time`, `XNNNRPM`). The
-    /// sampling rate comes from the CWRU file-name prefix: `12k_` is 12 kHz, `48k_` is 48 kHz,
-    /// and `normal_*` baseline files are 48 kHz (data README caveat 1); otherwise unknown.
-    CwruMat,
+    /// MATLAB v5 to v7.2 `.mat` (also `scipy.io.savemat`), structs included. CWRU files
+    /// (`XNNN_DE_time`, `XNNNRPM`) take their sampling rate from the file-name prefix: `12k_`
+    /// is 12 kHz, `48k_` is 48 kHz, and `normal_*` baseline files are 48 kHz (data README
+    /// caveat 1). Other files state it, if at all, in a scalar beside the signal (`fs`, `sr`,
+    /// ...; see the `mat` module).
+    Matlab,
     /// PRONOSTIA / PHM 2012 `acc_NNNNN.csv`: hour, minute, second, microsecond, horizontal,
     /// vertical (g), at 25.6 kHz. Recognised by the file name.
     PronostiaCsv,
@@ -65,16 +72,21 @@ pub enum RecordingFormat {
     /// as they are; the file holds no scale to g, so the amplitudes are relative (a warning
     /// says so).
     Wav,
+    /// An MCAP log written by `bearingd run` (or `import`): the raw blocks of one channel
+    /// (`sensor/axis`), in g, at the rate the blocks carry; the shaft speed from its speed or
+    /// indicators topic.
+    McapLog,
 }
 
 impl fmt::Display for RecordingFormat {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(match self {
-            RecordingFormat::CwruMat => "CWRU MATLAB v5 (.mat)",
+            RecordingFormat::Matlab => "MATLAB (.mat)",
             RecordingFormat::PronostiaCsv => "PRONOSTIA acc CSV",
             RecordingFormat::ImsText => "IMS text",
             RecordingFormat::PlainCsv => "plain CSV",
             RecordingFormat::Wav => "WAV",
+            RecordingFormat::McapLog => "bearingd MCAP log",
         })
     }
 }
@@ -84,8 +96,10 @@ impl fmt::Display for RecordingFormat {
 /// with the same value. `None` means the format's default channel.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReadOptions {
-    /// CWRU: `DE`, `FE`, `BA` or a variable name. PRONOSTIA: `horizontal` or `vertical`. IMS:
+    /// CWRU: `DE`, `FE`, `BA` or a variable name. Other MATLAB files: a variable or a field
+    /// path (`bearing.gs`, `s(2).x`, `c{1}`). PRONOSTIA: `horizontal` or `vertical`. IMS:
     /// `B1x` … `B4y` or `1` … `8`. CSV: a header name or a 1-based index. WAV: `1`, `2`, …
+    /// MCAP log: `sensor/axis`.
     pub channel: Option<String>,
     /// Synonym of `channel`, for tables.
     pub column: Option<String>,
@@ -102,7 +116,7 @@ pub enum RecordingError {
         #[source]
         source: std::io::Error,
     },
-    #[error("{path}: unknown recording format: {reason}; readable are MATLAB v5 .mat (CWRU), .wav, .csv/.tsv/.txt tables, PRONOSTIA acc_NNNNN.csv and IMS snapshots named like 2003.10.22.12.14.13")]
+    #[error("{path}: unknown recording format: {reason}; readable are MATLAB .mat (v5 to v7.2), .wav, .csv/.tsv/.txt tables, PRONOSTIA acc_NNNNN.csv, IMS snapshots named like 2003.10.22.12.14.13 and bearingd's .mcap logs")]
     UnknownFormat { path: PathBuf, reason: String },
     #[error("{path}: not a MATLAB v5 file: {reason}")]
     NotMatlab { path: PathBuf, reason: String },
@@ -115,32 +129,32 @@ pub enum RecordingError {
     },
     #[error("{path}: damaged MATLAB file: {detail}; fetch the file again or re-save it in MATLAB with save(file, '-v7')")]
     DamagedMat { path: PathBuf, detail: String },
-    #[error("{path}: no variable '{wanted}'; variables present: {}; choose one as the channel", list(.present))]
+    #[error("{path}: no variable '{wanted}'; variables present: {}; choose one with --channel", list(.present))]
     VariableNotFound {
         path: PathBuf,
         wanted: String,
         present: Vec<String>,
     },
-    #[error("{path}: {problem}; variables present: {}; choose the channel (DE, FE, BA or a variable name)", list(.present))]
+    #[error("{path}: {problem}: {}; choose one with --channel (DE, FE or BA for CWRU files, else a variable or field path, e.g. --channel {})", list(.present), example_channel(.present))]
     AmbiguousVariable {
         path: PathBuf,
         problem: String,
         present: Vec<String>,
     },
-    #[error("{path}: variable '{name}' {problem}; choose a variable that is a vector of samples")]
+    #[error("{path}: variable '{name}' {problem}; choose a vector of samples with --channel")]
     UnsupportedVariable {
         path: PathBuf,
         name: String,
         problem: String,
     },
-    #[error("{path}: no {kind} '{wanted}'; {kind}s present: {}", list(.available))]
+    #[error("{path}: no {kind} '{wanted}'; {kind}s present: {}; choose one with --{kind}", list(.available))]
     ChannelNotFound {
         path: PathBuf,
         kind: &'static str,
         wanted: String,
         available: Vec<String>,
     },
-    #[error("{path}: the table has {} columns ({}); choose one by header name or 1-based index", .available.len(), list(.available))]
+    #[error("{path}: the table has {} columns ({}); choose one with --column, by header name or 1-based index, e.g. --column {}", .available.len(), list(.available), .available.last().map_or("1", String::as_str))]
     ColumnRequired {
         path: PathBuf,
         available: Vec<String>,
@@ -164,12 +178,29 @@ pub enum RecordingError {
     },
     #[error("{path}: cannot read the WAV file: {detail}; re-export it as PCM or 32-bit float WAV")]
     BadWav { path: PathBuf, detail: String },
+    #[error("{path}: no variable holds a vector of samples; variables present: {}; save the signal as a vector, or choose one with --channel", list(.present))]
+    NoSignal { path: PathBuf, present: Vec<String> },
+    #[error("{path}: cannot read the MCAP log: {detail}")]
+    BadLog { path: PathBuf, detail: String },
+    #[error("{path}: the log holds {} channels ({}); choose one with --channel, e.g. --channel {}", .channels.len(), list(.channels), .channels.first().map_or("sensor/axis", String::as_str))]
+    AmbiguousLogChannel {
+        path: PathBuf,
+        channels: Vec<String>,
+    },
     #[error("{path}: channel '{channel}' and column '{column}' name different channels; give only one of them")]
     ConflictingSelection {
         path: PathBuf,
         channel: String,
         column: String,
     },
+}
+
+/// The first listed name without its description (`s.x (100x1)` → `s.x`), for an example.
+fn example_channel(present: &[String]) -> &str {
+    present
+        .first()
+        .and_then(|p| p.split(' ').next())
+        .unwrap_or("bearing.gs")
 }
 
 /// `a, b, c`, or `(none)`.
@@ -183,15 +214,22 @@ fn list(items: &[String]) -> String {
 
 /// Reads one channel of a recording. See [`RecordingFormat`] for what each format yields.
 pub fn read_recording(path: &Path, options: &ReadOptions) -> Result<Recording, RecordingError> {
-    let bytes = read_file(path)?;
     let selector = selector(path, options)?;
+    if is_log(path)? {
+        // A log can be large: it is read message by message, one channel kept.
+        let recording = mcap::read(path, selector)?;
+        check_finite(&recording)?;
+        return Ok(recording);
+    }
+    let bytes = read_file(path)?;
     let format = detect_format(path, &bytes)?;
     let recording = match format {
-        RecordingFormat::CwruMat => mat::read(path, &bytes, selector)?,
+        RecordingFormat::Matlab => mat::read(path, &bytes, selector)?,
         RecordingFormat::PronostiaCsv => csv::read_pronostia(path, &bytes, selector)?,
         RecordingFormat::ImsText => ims::read(path, &bytes, selector)?,
         RecordingFormat::PlainCsv => csv::read_plain(path, &bytes, selector)?,
         RecordingFormat::Wav => wav::read(path, &bytes, selector)?,
+        RecordingFormat::McapLog => mcap::read(path, selector)?,
     };
     check_finite(&recording)?;
     Ok(recording)
@@ -200,9 +238,12 @@ pub fn read_recording(path: &Path, options: &ReadOptions) -> Result<Recording, R
 /// The channels a file offers, in file order, as they can be passed in [`ReadOptions`]: MATLAB
 /// variable names, table column names, or WAV channel numbers.
 pub fn list_channels(path: &Path) -> Result<Vec<String>, RecordingError> {
+    if is_log(path)? {
+        return mcap::channels(path);
+    }
     let bytes = read_file(path)?;
     match detect_format(path, &bytes)? {
-        RecordingFormat::CwruMat => mat::channels(path, &bytes),
+        RecordingFormat::Matlab => mat::channels(path, &bytes),
         RecordingFormat::PronostiaCsv => Ok(csv::PRONOSTIA_CHANNELS
             .iter()
             .map(|s| s.to_string())
@@ -210,6 +251,7 @@ pub fn list_channels(path: &Path) -> Result<Vec<String>, RecordingError> {
         RecordingFormat::ImsText => ims::channels(path, &bytes),
         RecordingFormat::PlainCsv => csv::plain_channels(path, &bytes),
         RecordingFormat::Wav => wav::channels(path, &bytes),
+        RecordingFormat::McapLog => mcap::channels(path),
     }
 }
 
@@ -218,8 +260,8 @@ pub fn list_channels(path: &Path) -> Result<Vec<String>, RecordingError> {
 /// `.mat`, `.wav` and `.csv`/`.tsv`/`.txt` are taken at their word (a text file renamed `.mat`
 /// then fails as "not a MATLAB v5 file" rather than being read as something else); `acc_NNNNN.csv`
 /// is PRONOSTIA; a name like `2003.10.22.12.14.13` is IMS. Files without an extension are
-/// recognised by content: MATLAB and WAV headers, or a first line of 4 or 8 tab-separated
-/// numbers (IMS).
+/// recognised by content: MATLAB, WAV and MCAP headers, or a first line of 4 or 8
+/// tab-separated numbers (IMS). `.mcap` is an MCAP log.
 pub fn detect_format(path: &Path, head: &[u8]) -> Result<RecordingFormat, RecordingError> {
     let name = file_name(path);
     if ims::is_ims_name(&name) {
@@ -229,7 +271,8 @@ pub fn detect_format(path: &Path, head: &[u8]) -> Result<RecordingFormat, Record
         .extension()
         .map(|e| e.to_string_lossy().to_ascii_lowercase());
     match ext.as_deref() {
-        Some("mat") => return Ok(RecordingFormat::CwruMat),
+        Some("mat") => return Ok(RecordingFormat::Matlab),
+        Some("mcap") => return Ok(RecordingFormat::McapLog),
         Some("wav") | Some("wave") => return Ok(RecordingFormat::Wav),
         Some("csv") | Some("tsv") | Some("txt") => {
             return Ok(if csv::is_pronostia_name(&name) {
@@ -241,7 +284,10 @@ pub fn detect_format(path: &Path, head: &[u8]) -> Result<RecordingFormat, Record
         _ => {}
     }
     if head.starts_with(b"MATLAB") {
-        return Ok(RecordingFormat::CwruMat);
+        return Ok(RecordingFormat::Matlab);
+    }
+    if head.starts_with(mcap::MAGIC) {
+        return Ok(RecordingFormat::McapLog);
     }
     if head.len() >= 12 && head.starts_with(b"RIFF") && &head[8..12] == b"WAVE" {
         return Ok(RecordingFormat::Wav);
@@ -259,10 +305,30 @@ pub fn detect_format(path: &Path, head: &[u8]) -> Result<RecordingFormat, Record
     })
 }
 
-/// Reads the whole file: the largest inputs are a few MB, and one read means one consistent
-/// snapshot of a file that might be growing.
-fn read_file(path: &Path) -> Result<Vec<u8>, RecordingError> {
-    let bytes = std::fs::read(path).map_err(|source| match source.kind() {
+/// Whether `path` is an MCAP log (by name or first bytes), read without loading the file.
+fn is_log(path: &Path) -> Result<bool, RecordingError> {
+    Ok(matches!(
+        detect_format(path, &read_head(path)?),
+        Ok(RecordingFormat::McapLog)
+    ))
+}
+
+/// The first bytes of a file, enough to recognise its format.
+fn read_head(path: &Path) -> Result<Vec<u8>, RecordingError> {
+    use std::io::Read;
+    let file = std::fs::File::open(path).map_err(|source| io_error(path, source))?;
+    let mut head = Vec::with_capacity(HEAD_LEN);
+    file.take(HEAD_LEN as u64)
+        .read_to_end(&mut head)
+        .map_err(|source| io_error(path, source))?;
+    Ok(head)
+}
+
+/// Bytes [`read_head`] reads: a MATLAB header (128) and an IMS first line.
+const HEAD_LEN: usize = 512;
+
+fn io_error(path: &Path, source: std::io::Error) -> RecordingError {
+    match source.kind() {
         std::io::ErrorKind::NotFound => RecordingError::NotFound {
             path: path.to_path_buf(),
         },
@@ -270,7 +336,13 @@ fn read_file(path: &Path) -> Result<Vec<u8>, RecordingError> {
             path: path.to_path_buf(),
             source,
         },
-    })?;
+    }
+}
+
+/// Reads the whole file: the largest inputs are a few MB, and one read means one consistent
+/// snapshot of a file that might be growing.
+fn read_file(path: &Path) -> Result<Vec<u8>, RecordingError> {
+    let bytes = std::fs::read(path).map_err(|source| io_error(path, source))?;
     if bytes.is_empty() {
         return Err(RecordingError::Empty {
             path: path.to_path_buf(),

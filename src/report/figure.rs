@@ -2,6 +2,7 @@
 //! harmonics marked (tolerance shaded), and the kurtogram with the band that was used.
 
 use super::AnalyzeReport;
+use crate::analysis::iso::VelocitySeverity;
 use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::messages::FaultKind;
 use crate::plot::{Color, Figure, HeatmapPanel, HeatmapRow, Marker, Series, Shade, SpectrumPanel};
@@ -134,6 +135,12 @@ pub fn analysis_figure(
             report.band_selection.reason
         ))
         .with_panel(panel);
+    let figure = match &report.velocity {
+        Some(velocity) => figure
+            .with_note(velocity.summary())
+            .with_panel(velocity_panel(velocity, shaft)),
+        None => figure,
+    };
     let figure = match twin {
         Some(twin) => figure.with_panel(twin_panel(
             twin,
@@ -143,6 +150,45 @@ pub fn analysis_figure(
         None => figure,
     };
     figure.with_panel(heatmap)
+}
+
+/// The velocity spectrum the ISO 10816-3 value sums (RMS per bin, in the standard's band),
+/// with the shaft harmonics marked: where the velocity comes from (unbalance at 1x,
+/// misalignment at 2x, or broadband).
+fn velocity_panel(v: &VelocitySeverity, shaft_hz: f64) -> SpectrumPanel {
+    let x: Vec<f64> = (0..v.per_bin_mm2_s2.len())
+        .map(|k| k as f64 * v.bin_hz)
+        .collect();
+    let x_max = (v.band_hz[1] * 1.05).min(x.last().copied().unwrap_or(0.0));
+    let mut panel = SpectrumPanel::new("frequency (Hz)", "velocity RMS per bin (mm/s)", x);
+    panel.x_range = Some((0.0, x_max));
+    panel.series.push(Series {
+        label: format!(
+            "velocity {:.2} mm/s RMS, zone {}",
+            v.rms_mm_s,
+            v.zone.letter()
+        ),
+        y: v.per_bin_mm2_s2.iter().map(|p| p.sqrt()).collect(),
+        color: Color::BLUE,
+    });
+    panel.shaded.push(Shade {
+        x0: v.band_hz[0],
+        x1: v.band_hz[1],
+        color: Color::GREY.with_alpha(25),
+    });
+    for order in 1..=3 {
+        let at = order as f64 * shaft_hz;
+        if at > x_max {
+            break;
+        }
+        panel.markers.push(Marker {
+            x: at,
+            label: format!("{order}x shaft"),
+            color: Color::GREY,
+            dashed: true,
+        });
+    }
+    panel
 }
 
 /// The best twin's envelope spectrum over the measured one, in the twin's band and range.

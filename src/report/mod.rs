@@ -10,6 +10,7 @@ pub use text::render_text;
 
 use crate::analysis::fault_bands::HarmonicPeak;
 use crate::analysis::indicators::Indicators;
+use crate::analysis::iso::VelocitySeverity;
 use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::bearing::BearingGeometry;
 use crate::messages::FaultKind;
@@ -112,6 +113,9 @@ pub struct AnalyzeReport {
     pub thresholds: Thresholds,
     pub indicators: Indicators,
     pub hypotheses: Vec<HypothesisReport>,
+    /// ISO 10816-3 / 20816-3 velocity severity and zone; `null` when the record is not in g
+    /// (WAV) or too short.
+    pub velocity: Option<VelocitySeverity>,
     /// The signal-model twin's fit (`analyze --twin`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub twin: Option<TwinReport>,
@@ -268,6 +272,7 @@ impl AnalyzeReport {
                     harmonics: h.score.peaks().to_vec(),
                 })
                 .collect(),
+            velocity: None,
             twin: None,
             warnings: context.warnings.clone(),
         }

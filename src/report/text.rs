@@ -103,6 +103,9 @@ pub fn render_text(r: &AnalyzeReport) -> String {
         "  indicators: RMS {:.4} g, peak {:.3} g, crest {:.2}, kurtosis {:.2}",
         i.rms, i.peak, i.crest, i.kurtosis
     );
+    if let Some(v) = &r.velocity {
+        let _ = writeln!(out, "  {}", v.summary());
+    }
     for w in &r.warnings {
         let _ = writeln!(out, "  warning: {w}");
     }

@@ -9,7 +9,7 @@
 //! deterministic for a given seed.
 
 use super::rng::Rng;
-use crate::bearing::{BearingGeometry, FaultFrequencies};
+use crate::bearing::{BearingGeometry, FaultFrequencies, Race};
 use crate::messages::FaultKind;
 use serde::Serialize;
 
@@ -106,19 +106,25 @@ impl SimulationParams {
     /// Time between the entry and the exit impact of a defect of finite length:
     /// `Δt = Z·L / (2π r f_d)`, `r` the radius the rolling element runs on.
     pub fn entry_exit_delay_s(&self) -> f64 {
-        let g = &self.bearing;
-        let radius_mm = match self.fault {
-            SimulatedFault::OuterRace => (g.pitch_diameter_mm + g.element_diameter_mm) / 2.0,
-            SimulatedFault::InnerRace => (g.pitch_diameter_mm - g.element_diameter_mm) / 2.0,
-            SimulatedFault::Ball => g.element_diameter_mm / 2.0,
-            SimulatedFault::None => return 0.0,
-        };
         let f_d = self.impact_rate_hz();
         if self.defect_length_mm <= 0.0 || f_d <= 0.0 {
             return 0.0;
         }
-        f64::from(g.rolling_elements) * self.defect_length_mm
-            / (std::f64::consts::TAU * radius_mm * f_d)
+        let g = &self.bearing;
+        match self.fault {
+            SimulatedFault::OuterRace => {
+                g.entry_exit_delay_s(Race::Outer, self.defect_length_mm, f_d)
+            }
+            SimulatedFault::InnerRace => {
+                g.entry_exit_delay_s(Race::Inner, self.defect_length_mm, f_d)
+            }
+            // A ball defect runs on the ball's own radius.
+            SimulatedFault::Ball => {
+                f64::from(g.rolling_elements) * self.defect_length_mm
+                    / (std::f64::consts::TAU * g.element_diameter_mm / 2.0 * f_d)
+            }
+            SimulatedFault::None => 0.0,
+        }
     }
 
     /// Stribeck load `q(θ)/q_max` at angle θ from the load line.

@@ -110,6 +110,17 @@ pub fn python_iceoryx2() -> Option<PathBuf> {
     venv_python("import iceoryx2", "the Python iceoryx2 package")
 }
 
+/// The project's Python with scipy, whose `scipy.io.savemat` writes the MATLAB fixtures.
+///
+/// # Panics
+/// Under `CI=true` when it is missing (tests only).
+pub fn python_scipy() -> Option<PathBuf> {
+    venv_python(
+        "import scipy.io, numpy",
+        "scipy (scipy.io.savemat writes the MATLAB fixtures)",
+    )
+}
+
 fn venv_python(imports: &str, what: &str) -> Option<PathBuf> {
     let py = repo_root().join(".venv/bin/python");
     let ci = std::env::var("CI").is_ok_and(|v| v == "true");

@@ -1,0 +1,309 @@
+//! The MCAP logs `bearingd run` writes, read as a recording of one channel.
+//!
+//! What the log states is used, and said: the sample rate travels in every raw block, the
+//! scale to g too; the shaft speed is on `/speed/<sensor>/<axis>` (speed frames or estimates)
+//! or, for a fixed speed, in the indicators the daemon logged (`/indicators/...`, the speed it
+//! scored with). The bearing's geometry is not in the log yet; the caller decides (see
+//! `offline`). Blocks are joined in log order; gaps, overlaps (a sensor restart) and a change
+//! of sample rate are counted and reported, an unfinished file (a crash) is read as far as it
+//! is valid, with a warning.
+//!
+//! Coupling: only [`crate::mcap_log::read_messages`] and the message types; the log reader
+//! may move (the module "house"), this file should not need to.
+
+use super::{Recording, RecordingError, RecordingFormat};
+use crate::daemon::messages::PipelineMessage;
+use crate::mcap_log::{read_messages, LoggedMessage};
+use std::collections::BTreeSet;
+use std::path::Path;
+
+/// The first bytes of every MCAP file.
+pub(super) const MAGIC: &[u8] = ::mcap::MAGIC;
+
+/// Most samples of one channel kept (2^24: 11 minutes at 25.6 kHz, 128 MiB): `analyze` holds
+/// the record in memory. Longer logs are analysed over their first part, with a warning.
+const MAX_SAMPLES: usize = 1 << 24;
+
+/// A speed the log states: for a channel, from a sample on.
+struct StatedSpeed {
+    channel: String,
+    from_sample: u64,
+    rpm: f64,
+    /// `can`, `estimate`, or `indicators` (the speed a score was computed with).
+    source: String,
+}
+
+/// The chosen channel's samples as they are joined.
+struct Joined {
+    name: String,
+    fs_hz: f64,
+    first_sample: u64,
+    next_sample: u64,
+    samples: Vec<f64>,
+    /// Samples of this channel in the log beyond what was kept.
+    dropped_samples: u64,
+    gaps: u64,
+    missing_samples: u64,
+    overlaps: u64,
+    rate_change: Option<(u64, f64)>,
+}
+
+impl Joined {
+    fn push(&mut self, first_sample: u64, fs_hz: f64, scale: f64, counts: &[i32]) {
+        if self.rate_change.is_some() || self.samples.len() >= MAX_SAMPLES {
+            self.dropped_samples += counts.len() as u64;
+            return;
+        }
+        if fs_hz != self.fs_hz {
+            self.rate_change = Some((first_sample, fs_hz));
+            self.dropped_samples += counts.len() as u64;
+            return;
+        }
+        if first_sample > self.next_sample {
+            self.gaps += 1;
+            self.missing_samples += first_sample - self.next_sample;
+        } else if first_sample < self.next_sample {
+            self.overlaps += 1;
+        }
+        let room = MAX_SAMPLES - self.samples.len();
+        let take = counts.len().min(room);
+        self.samples
+            .extend(counts[..take].iter().map(|&c| f64::from(c) * scale));
+        self.dropped_samples += (counts.len() - take) as u64;
+        self.next_sample = first_sample + counts.len() as u64;
+    }
+}
+
+fn matches(wanted: &str, name: &str) -> bool {
+    let wanted = wanted.trim_start_matches('/');
+    let wanted = wanted.strip_prefix("raw/").unwrap_or(wanted);
+    wanted.eq_ignore_ascii_case(name)
+}
+
+pub(super) fn channels(path: &Path) -> Result<Vec<String>, RecordingError> {
+    let mut names = BTreeSet::new();
+    let mut first_error = None;
+    for item in read_messages(&[path]) {
+        match item {
+            Ok(LoggedMessage {
+                message: PipelineMessage::Raw(b),
+                ..
+            }) => {
+                names.insert(b.channel.to_string());
+            }
+            Ok(_) => {}
+            Err(e) => {
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    match (names.is_empty(), first_error) {
+        (true, Some(e)) => Err(bad_log(path, &e)),
+        _ => Ok(names.into_iter().collect()),
+    }
+}
+
+fn bad_log(path: &Path, e: &crate::mcap_log::McapLogError) -> RecordingError {
+    let text = e.to_string();
+    let shown = path.display().to_string();
+    let detail = text
+        .strip_prefix(&shown)
+        .map(|t| t.trim_start_matches(':').trim_start())
+        .unwrap_or(&text);
+    RecordingError::BadLog {
+        path: path.to_path_buf(),
+        detail: format!(
+            "{detail}; check that it is a log written by bearingd run or import (an unfinished one is read as far as it is valid)"
+        ),
+    }
+}
+
+pub(super) fn read(path: &Path, selector: Option<&str>) -> Result<Recording, RecordingError> {
+    let mut reader = read_messages(&[path]);
+    let mut joined: Option<Joined> = None;
+    let mut others = BTreeSet::new();
+    let mut speeds: Vec<StatedSpeed> = Vec::new();
+    let mut errors = 0u64;
+    let mut first_error = None;
+    for item in reader.by_ref() {
+        let logged = match item {
+            Ok(logged) => logged,
+            Err(e) => {
+                errors += 1;
+                first_error.get_or_insert(e);
+                continue;
+            }
+        };
+        match logged.message {
+            PipelineMessage::Raw(block) => {
+                let name = block.channel.to_string();
+                let wanted = match (selector, &joined) {
+                    (Some(s), _) => matches(s, &name),
+                    (None, Some(j)) => j.name == name,
+                    (None, None) => true,
+                };
+                if !wanted {
+                    others.insert(name);
+                    continue;
+                }
+                let j = joined.get_or_insert_with(|| Joined {
+                    name,
+                    fs_hz: block.sample_rate_hz,
+                    first_sample: block.first_sample,
+                    next_sample: block.first_sample,
+                    samples: Vec::new(),
+                    dropped_samples: 0,
+                    gaps: 0,
+                    missing_samples: 0,
+                    overlaps: 0,
+                    rate_change: None,
+                });
+                j.push(
+                    block.first_sample,
+                    block.sample_rate_hz,
+                    block.scale_g_per_count,
+                    &block.counts,
+                );
+            }
+            PipelineMessage::Speed(s) => speeds.extend(s.rpm.map(|rpm| StatedSpeed {
+                channel: s.channel.to_string(),
+                from_sample: s.end_sample,
+                rpm,
+                source: s.source,
+            })),
+            PipelineMessage::Indicators(i) => speeds.push(StatedSpeed {
+                channel: i.channel.to_string(),
+                from_sample: i.end_sample,
+                rpm: i.rpm,
+                source: "indicators".into(),
+            }),
+            _ => {}
+        }
+    }
+    let Some(j) = joined else {
+        if let (Some(e), true) = (&first_error, others.is_empty()) {
+            return Err(bad_log(path, e));
+        }
+        return match selector {
+            Some(wanted) if !others.is_empty() => Err(RecordingError::ChannelNotFound {
+                path: path.to_path_buf(),
+                kind: "channel",
+                wanted: wanted.to_string(),
+                available: others.into_iter().collect(),
+            }),
+            _ => Err(RecordingError::Empty {
+                path: path.to_path_buf(),
+                detail: "the log holds no raw samples (no /raw/<sensor>/<axis> topic); analyse a log written by bearingd run or import".to_string(),
+            }),
+        };
+    };
+    if selector.is_none() && !others.is_empty() {
+        let mut all: Vec<String> = others.into_iter().collect();
+        all.push(j.name.clone());
+        all.sort();
+        return Err(RecordingError::AmbiguousLogChannel {
+            path: path.to_path_buf(),
+            channels: all,
+        });
+    }
+    let mut warnings = Vec::new();
+    let summary = reader.summary();
+    if summary.unfinished_files() > 0 {
+        warnings.push(format!(
+            "the log is unfinished (bearingd did not close it: a crash or a copy taken while it ran); read up to its last complete chunk, {} byte(s) could not be read",
+            summary.unreadable_bytes()
+        ));
+    }
+    if errors > 0 {
+        let first = first_error.map(|e| e.to_string()).unwrap_or_default();
+        warnings.push(format!(
+            "{errors} message(s) could not be decoded and were skipped; the first: {first}"
+        ));
+    }
+    if j.gaps > 0 {
+        warnings.push(format!(
+            "{} gap(s) in the samples ({} sample(s) missing, lost before logging); the blocks were joined end to end",
+            j.gaps, j.missing_samples
+        ));
+    }
+    if j.overlaps > 0 {
+        warnings.push(format!(
+            "{} time(s) the sample count went back (a sensor restart); the blocks were joined end to end",
+            j.overlaps
+        ));
+    }
+    if let Some((at, fs)) = j.rate_change {
+        warnings.push(format!(
+            "the sample rate changes from {} Hz to {fs} Hz at sample {at}; analysed the part before",
+            j.fs_hz
+        ));
+    } else if j.dropped_samples > 0 {
+        warnings.push(format!(
+            "analysed the first {:.0} s of the channel; the log holds {:.0} s more (replay it with bearingd replay to follow it through time)",
+            j.samples.len() as f64 / j.fs_hz,
+            j.dropped_samples as f64 / j.fs_hz
+        ));
+    }
+    let end = j.first_sample + j.samples.len() as u64;
+    let rpm = speed_of(&speeds, j.first_sample, end, &j.name, &mut warnings);
+    let fs_hz = (j.fs_hz.is_finite() && j.fs_hz > 0.0).then_some(j.fs_hz);
+    Ok(Recording {
+        path: path.to_path_buf(),
+        format: RecordingFormat::McapLog,
+        channel: j.name,
+        fs_hz,
+        rpm,
+        samples: j.samples,
+        warnings,
+    })
+}
+
+/// The speed over samples `[start, end)` of `channel`: the median of the speeds stated on its
+/// speed topic up to `end`, else of those its indicators were computed with; a warning says
+/// which and how much it varied.
+fn speed_of(
+    speeds: &[StatedSpeed],
+    start: u64,
+    end: u64,
+    channel: &str,
+    warnings: &mut Vec<String>,
+) -> Option<f64> {
+    let usable = |s: &&StatedSpeed| {
+        s.channel == channel && s.from_sample <= end && s.rpm.is_finite() && s.rpm > 0.0
+    };
+    let stated: Vec<&StatedSpeed> = speeds
+        .iter()
+        .filter(usable)
+        .filter(|s| s.source != "indicators")
+        .collect();
+    let (chosen, from) = if stated.is_empty() {
+        let scored: Vec<&StatedSpeed> = speeds
+            .iter()
+            .filter(usable)
+            .filter(|s| s.source == "indicators" && s.from_sample > start)
+            .collect();
+        (
+            scored,
+            format!("/indicators/{channel} (the speed the daemon scored with)"),
+        )
+    } else {
+        let sources: BTreeSet<&str> = stated.iter().map(|s| s.source.as_str()).collect();
+        let sources: Vec<&str> = sources.into_iter().collect();
+        (stated, format!("/speed/{channel} ({})", sources.join(", ")))
+    };
+    let mut sorted: Vec<f64> = chosen.iter().map(|s| s.rpm).collect();
+    if sorted.is_empty() {
+        return None;
+    }
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted[sorted.len() / 2];
+    let (lo, hi) = (sorted[0], sorted[sorted.len() - 1]);
+    if hi > lo * 1.01 {
+        warnings.push(format!(
+            "the speed varies from {lo:.1} to {hi:.1} rpm over the log ({from}); analysed at the median {median:.1} rpm: fault lines blur where it differs by more than the slip tolerance, give --rpm or analyse a shorter log"
+        ));
+    } else {
+        warnings.push(format!("speed {median:.1} rpm from {from}"));
+    }
+    Some(median)
+}
