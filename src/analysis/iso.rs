@@ -690,6 +690,6 @@ mod tests {
             .filter_map(|r| flag.update(r.rms_mm_s, r.end_sample))
             .collect();
         assert_eq!(changes.len(), 1, "{changes:?}");
-        assert_eq!(changes[0].to, super::super::flags::FlagLevel::Watch);
+        assert_eq!(changes[0].to, crate::messages::FlagLevel::Watch);
     }
 }

@@ -12,8 +12,8 @@
 //! may move (the module "house"), this file should not need to.
 
 use super::{Recording, RecordingError, RecordingFormat};
-use crate::daemon::messages::PipelineMessage;
 use crate::mcap_log::{read_messages, LoggedMessage};
+use crate::messages::PipelineMessage;
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -169,7 +169,7 @@ pub(super) fn read(path: &Path, selector: Option<&str>) -> Result<Recording, Rec
                 channel: s.channel.to_string(),
                 from_sample: s.end_sample,
                 rpm,
-                source: s.source,
+                source: s.source.name().into(),
             })),
             PipelineMessage::Indicators(i) => speeds.push(StatedSpeed {
                 channel: i.channel.to_string(),

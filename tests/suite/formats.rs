@@ -4,7 +4,7 @@
 //! struct by `scipy.io.savemat`, logged to MCAP by `bearingd run`, cut to a 2,560-sample
 //! PRONOSTIA snapshot, and written as WAV. No third-party data is committed or needed.
 
-use bearingd::recording::testdata::{python_scipy, scratch_dir, shared_data_dir};
+use bearingd_testdata::{python_scipy, scratch_dir, shared_data_dir};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -3,7 +3,7 @@
 //! record is an analytic sine, whose velocity RMS is known in closed form: a peak
 //! acceleration `a` g at `f` Hz is `a·g₀/(2πf)/√2` m/s RMS.
 
-use bearingd::recording::testdata::scratch_dir;
+use bearingd_testdata::scratch_dir;
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Command, Output};
