@@ -3,6 +3,7 @@
 use super::run::print_events;
 use super::CliError;
 use crate::config::{self, Config};
+use crate::daemon::lock::DirLock;
 use crate::daemon::{replay, ReplayOptions};
 use crate::pipeline::Sink;
 use crate::sinks::mcap::McapSink;
@@ -52,6 +53,11 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
         }
     }
     config.outputs.mcap_dir = args.out.clone();
+    // The output directory has one owner too: recovery at open would otherwise rewrite the
+    // open file of a daemon (or another replay) writing there.
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| CliError::input(format!("{}: cannot create: {e}", args.out.display())))?;
+    let _lock = DirLock::acquire(&args.out).map_err(CliError::input)?;
     let (sink, _) = McapSink::for_config(&config, 0).map_err(CliError::input)?;
     let mut sinks: Vec<Box<dyn Sink>> = vec![Box::new(sink)];
     let options = ReplayOptions {

@@ -7,6 +7,7 @@ use crate::daemon::state::StateError;
 use crate::daemon::{run, DaemonEvent, Events, RunOptions};
 use crate::messages::{HealthKind, PipelineMessage, SpeedSource};
 use crate::pipeline::{ChannelStatus, Sink, SinkError};
+use crate::sinks::mcap::{RecoveryAction, RecoveryReport};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -159,16 +160,10 @@ pub(super) fn print_events() -> Events {
 /// How an event other than a status reads on stderr.
 fn event_line(event: &DaemonEvent) -> String {
     match event {
-        DaemonEvent::Recovered(report) => format!(
-            "bearingd: recovered {}: {} messages kept, {} bytes unreadable{}",
-            report.path.display(),
-            report.messages_recovered,
-            report.unreadable_bytes,
-            report
-                .problem
-                .as_ref()
-                .map(|(at, why)| format!(" (from byte {at}: {why})"))
-                .unwrap_or_default()
+        DaemonEvent::Recovered(report) => recovery_line(report),
+        DaemonEvent::StaleLockTakenOver { path, previous } => format!(
+            "bearingd: {}: taken over from a previous bearingd that did not stop cleanly ({previous})",
+            path.display()
         ),
         DaemonEvent::LoggingTo(path) => format!("bearingd: logging to {}", path.display()),
         DaemonEvent::AlertsOn { service, root } => format!(
@@ -209,6 +204,34 @@ fn event_line(event: &DaemonEvent) -> String {
             raw_blocks,
             flag_changes
         ),
+    }
+}
+
+/// What recovery did with one unfinished file, in one line.
+fn recovery_line(report: &RecoveryReport) -> String {
+    let problem = report
+        .problem
+        .as_ref()
+        .map(|(at, why)| format!(" (from byte {at}: {why})"))
+        .unwrap_or_default();
+    let path = report.path.display();
+    match &report.action {
+        RecoveryAction::Rewritten { original_kept } => format!(
+            "bearingd: recovered {path}: {} messages kept, {} bytes unreadable{problem}{}",
+            report.messages_recovered,
+            report.unreadable_bytes,
+            original_kept
+                .as_ref()
+                .map(|k| format!("; damaged original kept as {}", k.display()))
+                .unwrap_or_default()
+        ),
+        RecoveryAction::Quarantined { to, reason } => format!(
+            "bearingd: warning: {path} could not be recovered ({reason}); moved, untouched, to {}",
+            to.display()
+        ),
+        RecoveryAction::RemovedEmpty => {
+            format!("bearingd: removed {path}: an empty file (0 bytes) left by an earlier start")
+        }
     }
 }
 

@@ -24,6 +24,9 @@ pub fn ignore_events() -> Events {
 /// Something the operator should know.
 #[derive(Debug)]
 pub enum DaemonEvent {
+    /// A data directory's lock file named a previous owner that did not stop cleanly (killed,
+    /// or the power went): its lock was free and is now this process's.
+    StaleLockTakenOver { path: PathBuf, previous: String },
     /// A file a crash left unfinished was recovered at start.
     Recovered(RecoveryReport),
     /// The MCAP log's first file is open.

@@ -31,6 +31,7 @@
 //! closes the sink queue, which ends the sink thread.
 
 use super::events::{DaemonEvent, Events};
+use super::lock::{DirLock, LockError};
 use super::state::{load_baselines, save_baselines};
 use crate::config::{Config, Transport};
 use crate::mcap_log::McapLogError;
@@ -72,6 +73,8 @@ pub enum RunError {
         path: PathBuf,
         source: std::io::Error,
     },
+    #[error(transparent)]
+    Locked(#[from] LockError),
     #[error("MCAP log: {0}")]
     Log(#[from] McapLogError),
     #[cfg(feature = "shm")]
@@ -114,6 +117,7 @@ pub async fn run(
     shutdown: impl std::future::Future<Output = ()>,
 ) -> Result<RunSummary, RunError> {
     let state_dir = prepare_state_dir(&config)?;
+    let _locks = lock_data_dirs(&config, &events)?;
     sinks.push(Box::new(open_log(&config, &events)?));
     let alerts = start_alerts(&config, &events)?;
     let (baselines, problem) = load_baselines(&state_dir);
@@ -195,6 +199,34 @@ fn prepare_state_dir(config: &Config) -> Result<PathBuf, RunError> {
         source,
     })?;
     Ok(state_dir)
+}
+
+/// Locks the log and state directories (one owner each) before anything in them is opened;
+/// the locks are held until `run` returns.
+fn lock_data_dirs(config: &Config, events: &Events) -> Result<Vec<DirLock>, RunError> {
+    let dirs = [&config.outputs.mcap_dir, &config.outputs.state_dir];
+    let mut locks: Vec<DirLock> = Vec::new();
+    let mut locked: Vec<PathBuf> = Vec::new();
+    for dir in dirs {
+        std::fs::create_dir_all(dir).map_err(|source| RunError::Directory {
+            path: dir.clone(),
+            source,
+        })?;
+        let same = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.clone());
+        if locked.contains(&same) {
+            continue;
+        }
+        let lock = DirLock::acquire(dir)?;
+        if let Some(previous) = &lock.taken_over_from {
+            events(DaemonEvent::StaleLockTakenOver {
+                path: lock.path().to_path_buf(),
+                previous: previous.clone(),
+            });
+        }
+        locked.push(same);
+        locks.push(lock);
+    }
+    Ok(locks)
 }
 
 /// Recovers what a crash left in the log directory and opens the log, sample 0 at now.

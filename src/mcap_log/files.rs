@@ -21,6 +21,20 @@ pub fn file_name(opened_at_ns: u64, seq: u32) -> String {
     )
 }
 
+/// `YYYY-MM-DDTHH:MM:SS.mmmZ` (RFC 3339, UTC) for a time in ns since the epoch.
+pub fn utc_text(ns: u64) -> String {
+    let secs = ns / 1_000_000_000;
+    let rem = secs % 86_400;
+    let (y, m, d) = civil_from_days((secs / 86_400) as i64);
+    format!(
+        "{y:04}-{m:02}-{d:02}T{:02}:{:02}:{:02}.{:03}Z",
+        rem / 3600,
+        (rem / 60) % 60,
+        rem % 60,
+        (ns % 1_000_000_000) / 1_000_000
+    )
+}
+
 /// Gregorian date of a day count since 1970-01-01 (the well-known era/day-of-era method).
 fn civil_from_days(z: i64) -> (i64, u32, u32) {
     let z = z + 719_468;

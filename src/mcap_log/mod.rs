@@ -14,12 +14,15 @@
 //!   recovery.
 //! - no clock inside: the caller passes every timestamp, so tests and replays are
 //!   deterministic.
+//! - a file that replaces another (recovery) must first pass a strict read by the `mcap`
+//!   crate's own reader (`verify.rs`), independent of the scanner that produced it.
 
 pub(crate) mod error;
 pub mod files;
 pub mod reader;
 pub mod scan;
 pub mod schema;
+pub mod verify;
 
 pub use error::{McapLogError, Result};
 pub use files::{file_name, is_log_file_name};
@@ -28,3 +31,4 @@ pub use reader::{
     ReadSummary,
 };
 pub use scan::ScanOutcome;
+pub use verify::{read_back_strictly, StrictRead};

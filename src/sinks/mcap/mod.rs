@@ -7,7 +7,9 @@
 pub mod recover;
 pub mod writer;
 
-pub use recover::{is_finished, recover_directory, recover_file, RecoveryReport};
+pub use recover::{
+    is_finished, recover_directory, recover_file, RecoveryAction, RecoveryReport, QUARANTINE_DIR,
+};
 pub use writer::{enforce_budget, LogStats, LoggerConfig, McapLogger, RetentionReport, TopicStats};
 
 use crate::config::Config;

@@ -1,16 +1,28 @@
-//! Start-up recovery of files a crashed run left unfinished.
+//! Start-up recovery of files a crashed run left unfinished. Recovery never destroys.
 //!
 //! A writer killed with `kill -9` (or a power cut) leaves a file without summary, footer and
 //! end magic; strict readers (Python's `make_reader`, Foxglove's indexed loading) refuse it.
 //! Every complete chunk in it is still good, so [`recover_directory`] rewrites each such file
 //! from its complete records into a finished one.
 //!
-//! Choice: the recovered file **replaces the original under the same name**. It is written to
-//! `<name>.recovering`, fsynced, renamed over the original, and the directory is fsynced, so
-//! at every instant the name holds either the old bytes or the complete new file. The dropped
-//! bytes are exactly those no reader can decode (the open chunk, a damaged chunk); keeping
-//! them would cost disk budget for nothing. The report says how many there were.
-//! A leftover `*.recovering` from a crash during recovery is deleted and redone.
+//! How, for each unfinished `bearingd-*.mcap`:
+//! - nothing in it can be read (not MCAP at all, or not one record: a random file named like a
+//!   log, a file cut before its first chunk) → it is **moved to `quarantine/`** beside the logs,
+//!   untouched, and the report says why. An empty (0-byte) file holds nothing and is removed.
+//! - otherwise the readable records are copied to `<name>.recovering`, fsynced, and the copy is
+//!   **read back strictly** by the `mcap` crate's own reader
+//!   ([`crate::mcap_log::read_back_strictly`]: every CRC, the summary, the message count). Only
+//!   then is it renamed over the original and the directory fsynced, so the name holds either
+//!   the old bytes or the complete new file at every instant. A copy that fails the check is
+//!   deleted and the original goes to `quarantine/`.
+//! - when chunks *inside* the file were damaged (skipped, not just a cut-off tail), the
+//!   original is first hard-linked into `quarantine/` so that its bytes stay for an expert.
+//!   A cut-off tail (the chunk being written at the kill) cannot be decoded by anyone and is
+//!   only counted.
+//!
+//! Quarantined files are never deleted by retention; the operator clears `quarantine/`.
+//! A leftover `*.recovering` from a crash during recovery is an incomplete copy (its original
+//! is still in place): it is deleted and the recovery redone.
 
 use std::collections::HashMap;
 use std::fs::File;
@@ -22,7 +34,8 @@ use mcap::{Compression, WriteOptions};
 
 use crate::mcap_log::error::{io_err, McapLogError, Result};
 use crate::mcap_log::files::is_log_file_name;
-use crate::mcap_log::scan::{ScannedRecord, Scanner};
+use crate::mcap_log::scan::{ScanOutcome, ScannedRecord, Scanner};
+use crate::mcap_log::verify::read_back_strictly;
 
 /// What recovering one file did.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -36,9 +49,26 @@ pub struct RecoveryReport {
     pub original_bytes: u64,
     /// Where and why reading the original stopped, if it did before its end.
     pub problem: Option<(u64, String)>,
+    /// What became of the original.
+    pub action: RecoveryAction,
+}
+
+/// What recovery did with an unfinished file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum RecoveryAction {
+    /// The recovered copy (read back strictly) replaced it; `original_kept` is the hard link
+    /// to the original's bytes in `quarantine/` when chunks inside it were damaged.
+    Rewritten { original_kept: Option<PathBuf> },
+    /// Nothing could be recovered from it, or the copy failed the strict read: moved, as it
+    /// was, to `to` (in `quarantine/`).
+    Quarantined { to: PathBuf, reason: String },
+    /// It was empty (0 bytes: nothing to keep) and was removed.
+    RemovedEmpty,
 }
 
 const TEMP_SUFFIX: &str = ".recovering";
+/// The directory beside the logs where files recovery could not use are kept.
+pub const QUARANTINE_DIR: &str = "quarantine";
 
 /// Finds `bearingd-*.mcap` files in `dir` that are not finished and recovers each; see the
 /// module docs. Call it before opening a new logger in `dir`. Finished files are not touched.
@@ -89,19 +119,120 @@ pub fn is_finished(path: &Path) -> Result<bool> {
         && tail[29..] == *mcap::MAGIC)
 }
 
-/// Rewrites one file from its complete records (whether or not it was finished).
+/// Recovers one unfinished file as the module docs say: rewritten from its complete records
+/// (the copy checked strictly before it replaces the original), or quarantined.
 pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
     let original_bytes = std::fs::metadata(path).map_err(io_err(path, "stat"))?.len();
+    let report = |action, messages_recovered, outcome: &ScanOutcome, problem| RecoveryReport {
+        path: path.to_path_buf(),
+        messages_recovered,
+        unreadable_bytes: outcome.unreadable_bytes,
+        original_bytes,
+        problem,
+        action,
+    };
+    if original_bytes == 0 {
+        std::fs::remove_file(path).map_err(io_err(path, "remove empty file"))?;
+        return Ok(report(
+            RecoveryAction::RemovedEmpty,
+            0,
+            &ScanOutcome::default(),
+            None,
+        ));
+    }
     let mut temp_name = path.as_os_str().to_owned();
     temp_name.push(TEMP_SUFFIX);
     let temp = PathBuf::from(temp_name);
+    let copied = copy_readable_records(path, &temp);
+    let (copy, outcome) = match copied {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = std::fs::remove_file(&temp);
+            let to = quarantine(path, false)?;
+            return Ok(report(
+                RecoveryAction::Quarantined {
+                    to,
+                    reason: format!("the copy could not be written: {e}"),
+                },
+                0,
+                &ScanOutcome::default(),
+                None,
+            ));
+        }
+    };
+    let mut problem = outcome.first_problem.clone();
+    if copy.orphans > 0 && problem.is_none() {
+        problem = Some((
+            0,
+            format!("{} messages on channels without a record", copy.orphans),
+        ));
+    }
+    if copy.records == 0 {
+        let _ = std::fs::remove_file(&temp);
+        let reason = problem
+            .as_ref()
+            .map(|(at, why)| format!("nothing readable (byte {at}: {why})"))
+            .unwrap_or_else(|| "nothing readable".into());
+        let to = quarantine(path, false)?;
+        return Ok(report(
+            RecoveryAction::Quarantined { to, reason },
+            0,
+            &outcome,
+            problem,
+        ));
+    }
+    match read_back_strictly(&temp) {
+        Ok(read) if read.messages == copy.messages => {}
+        checked => {
+            let _ = std::fs::remove_file(&temp);
+            let reason = match checked {
+                Ok(read) => format!(
+                    "the recovered copy holds {} messages, {} were copied",
+                    read.messages, copy.messages
+                ),
+                Err(e) => format!("the recovered copy failed the strict read: {e}"),
+            };
+            let to = quarantine(path, false)?;
+            return Ok(report(
+                RecoveryAction::Quarantined { to, reason },
+                0,
+                &outcome,
+                problem,
+            ));
+        }
+    }
+    let original_kept = if outcome.chunks_skipped > 0 {
+        Some(quarantine(path, true)?)
+    } else {
+        None
+    };
+    std::fs::rename(&temp, path).map_err(io_err(path, "rename recovered file over"))?;
+    sync_parent(path);
+    Ok(report(
+        RecoveryAction::Rewritten { original_kept },
+        copy.messages,
+        &outcome,
+        problem,
+    ))
+}
+
+/// What [`copy_readable_records`] wrote.
+struct Copied {
+    /// Schemas, channels and messages copied.
+    records: u64,
+    messages: u64,
+    /// Messages whose channel record was not found (not copied).
+    orphans: u64,
+}
+
+/// Writes every readable record of `path` into a new finished file `temp`, fsynced.
+fn copy_readable_records(path: &Path, temp: &Path) -> Result<(Copied, ScanOutcome)> {
     let werr = |source| McapLogError::Write {
-        path: temp.clone(),
+        path: temp.to_path_buf(),
         source,
     };
-
     let mut scanner = Scanner::open(path)?;
-    let file = File::create(&temp).map_err(io_err(&temp, "create"))?;
+    let file = File::create(temp).map_err(io_err(temp, "create"))?;
     let mut writer = WriteOptions::new()
         .profile("")
         .library(concat!("bearingd ", env!("CARGO_PKG_VERSION"), " recovery"))
@@ -110,8 +241,11 @@ pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
         .map_err(werr)?;
     let mut schema_ids: HashMap<u16, u16> = HashMap::new();
     let mut channel_ids: HashMap<u16, u16> = HashMap::new();
-    let mut messages = 0u64;
-    let mut orphans = 0u64;
+    let mut copied = Copied {
+        records: 0,
+        messages: 0,
+        orphans: 0,
+    };
     while let Some(record) = scanner.next_record()? {
         match record {
             ScannedRecord::Schema {
@@ -122,6 +256,7 @@ pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
             } => {
                 let new = writer.add_schema(&name, &encoding, &data).map_err(werr)?;
                 schema_ids.insert(id, new);
+                copied.records += 1;
             }
             ScannedRecord::Channel {
                 id,
@@ -140,6 +275,7 @@ pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
                         .add_channel(s, &topic, &message_encoding, &metadata)
                         .map_err(werr)?;
                     channel_ids.insert(id, new);
+                    copied.records += 1;
                 }
             }
             ScannedRecord::Message {
@@ -151,7 +287,7 @@ pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
                 ..
             } => {
                 let Some(&channel_id) = channel_ids.get(&channel_id) else {
-                    orphans += 1;
+                    copied.orphans += 1;
                     continue;
                 };
                 let header = MessageHeader {
@@ -163,7 +299,8 @@ pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
                 writer
                     .write_to_known_channel(&header, &data)
                     .map_err(werr)?;
-                messages += 1;
+                copied.messages += 1;
+                copied.records += 1;
             }
         }
     }
@@ -171,34 +308,50 @@ pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
     let file = writer
         .into_inner()
         .into_inner()
-        .map_err(|e| io_err(&temp, "flush")(e.into_error()))?;
-    file.sync_all().map_err(io_err(&temp, "fsync"))?;
-    drop(file);
-    std::fs::rename(&temp, path).map_err(io_err(path, "rename recovered file over"))?;
-    if let Some(dir) = path.parent() {
-        let dir = if dir.as_os_str().is_empty() {
-            Path::new(".")
-        } else {
-            dir
-        };
-        // Make the rename durable; a directory that cannot be opened for fsync is not fatal.
-        if let Ok(d) = File::open(dir) {
-            let _ = d.sync_all();
+        .map_err(|e| io_err(temp, "flush")(e.into_error()))?;
+    file.sync_all().map_err(io_err(temp, "fsync"))?;
+    Ok((copied, scanner.outcome().clone()))
+}
+
+/// Moves `path` (or, with `keep_link`, hard-links it) into `quarantine/` beside it, under a
+/// name not yet taken there; returns the new path.
+fn quarantine(path: &Path, keep_link: bool) -> Result<PathBuf> {
+    let dir = parent_dir(path).join(QUARANTINE_DIR);
+    std::fs::create_dir_all(&dir).map_err(io_err(&dir, "create the quarantine directory"))?;
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "unnamed".into());
+    let mut to = dir.join(&name);
+    let mut n = 1;
+    while to.exists() {
+        to = dir.join(format!("{name}.{n}"));
+        n += 1;
+    }
+    if keep_link {
+        // A file system without hard links gets a copy.
+        if std::fs::hard_link(path, &to).is_err() {
+            std::fs::copy(path, &to).map_err(io_err(&to, "keep the original in quarantine"))?;
         }
+    } else {
+        std::fs::rename(path, &to).map_err(io_err(&to, "move into quarantine"))?;
     }
-    let outcome = scanner.outcome();
-    let mut problem = outcome.first_problem.clone();
-    if orphans > 0 && problem.is_none() {
-        problem = Some((
-            0,
-            format!("{orphans} messages on channels without a record"),
-        ));
+    sync_parent(&to);
+    sync_parent(path);
+    Ok(to)
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => dir,
+        _ => Path::new("."),
     }
-    Ok(RecoveryReport {
-        path: path.to_path_buf(),
-        messages_recovered: messages,
-        unreadable_bytes: outcome.unreadable_bytes,
-        original_bytes,
-        problem,
-    })
+}
+
+/// Makes a rename in `path`'s directory durable; a directory that cannot be opened for fsync
+/// is not fatal.
+fn sync_parent(path: &Path) {
+    if let Ok(d) = File::open(parent_dir(path)) {
+        let _ = d.sync_all();
+    }
 }

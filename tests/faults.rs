@@ -1,0 +1,241 @@
+//! Faults injected into `bearingd run` as a process, each checked for what it must not cost:
+//! two daemons on one data directory, a daemon killed with `kill -9` (its lock left behind),
+//! a random file named like a log, a log damaged in the middle. Every log file that is left is
+//! read back strictly by Python's `mcap` reader. (Issue 11.)
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use bearingd::mcap_log::read_messages;
+use bearingd::messages::PipelineMessage;
+use bearingd_testdata::{check_mcap_with_python, python_mcap, scratch_dir};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn bearingd(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(args)
+        .output()
+        .expect("run bearingd")
+}
+
+/// A one-second `--fast` run of the embedded default on `data`.
+fn short_run(data: &Path) -> Output {
+    bearingd(&[
+        "run",
+        "--fast",
+        "--duration",
+        "1",
+        "--quiet",
+        "--data-dir",
+        data.to_str().unwrap(),
+    ])
+}
+
+/// The embedded default in real time on `data`, until stopped.
+fn start_daemon(data: &Path) -> Child {
+    Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(["run", "--quiet", "--data-dir", data.to_str().unwrap()])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+fn mcap_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    files
+}
+
+/// Waits until the daemon's log file holds at least `bytes` (its first flushes are on disk).
+fn wait_for_log(data: &Path, bytes: u64) -> PathBuf {
+    let deadline = Instant::now() + Duration::from_secs(60);
+    loop {
+        if let Some(file) = mcap_files(&data.join("mcap")).pop() {
+            if std::fs::metadata(&file).map(|m| m.len()).unwrap_or(0) >= bytes {
+                return file;
+            }
+        }
+        assert!(Instant::now() < deadline, "no log in {}", data.display());
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+fn stderr_of(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn raw_blocks(files: &[PathBuf]) -> usize {
+    read_messages(files)
+        .filter(|m| matches!(m.as_ref().map(|m| &m.message), Ok(PipelineMessage::Raw(_))))
+        .count()
+}
+
+fn terminate(child: &mut Child) {
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+#[test]
+fn a_second_daemon_on_the_same_data_dir_exits_2_naming_the_first_and_touches_nothing() {
+    let dir = scratch_dir("faults-two");
+    let data = dir.join("data");
+    let mut first = start_daemon(&data);
+    let open = wait_for_log(&data, 1);
+
+    let second = short_run(&data);
+    let stderr = stderr_of(&second);
+    assert_eq!(second.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains(&format!("pid={}", first.id())) && stderr.contains("in use by another"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("recovered"), "{stderr}");
+    assert_eq!(mcap_files(&data.join("mcap")), vec![open.clone()]);
+
+    // The first daemon goes on logging to its file and finishes it cleanly.
+    let before = std::fs::metadata(&open).unwrap().len();
+    wait_for_log(&data, before + 1);
+    terminate(&mut first);
+    let out = first.wait_with_output().unwrap();
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    assert!(raw_blocks(std::slice::from_ref(&open)) > 0);
+    if let Some(py) = python_mcap() {
+        check_mcap_with_python(&py, &open, None);
+    }
+    // A clean stop releases the lock: the next start says nothing about a previous owner.
+    let next = short_run(&data);
+    assert!(next.status.success(), "{}", stderr_of(&next));
+    assert!(
+        !stderr_of(&next).contains("taken over"),
+        "{}",
+        stderr_of(&next)
+    );
+}
+
+#[test]
+fn the_lock_of_a_daemon_killed_with_sigkill_is_taken_over_and_said() {
+    let dir = scratch_dir("faults-stale");
+    let data = dir.join("data");
+    let mut killed = start_daemon(&data);
+    wait_for_log(&data, 1);
+    let pid = killed.id();
+    killed.kill().unwrap(); // SIGKILL
+    killed.wait().unwrap();
+    let lock = std::fs::read_to_string(data.join("mcap/bearingd.lock")).unwrap();
+    assert!(lock.contains(&format!("pid={pid} ")), "{lock}");
+
+    let out = short_run(&data);
+    let stderr = stderr_of(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("taken over") && stderr.contains(&format!("pid={pid} ")),
+        "{stderr}"
+    );
+}
+
+/// A deterministic pseudo-random byte stream (xorshift), for files that are not logs.
+fn noise(len: usize, mut seed: u64) -> Vec<u8> {
+    (0..len)
+        .map(|_| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed as u8
+        })
+        .collect()
+}
+
+#[test]
+fn a_random_file_named_like_a_log_is_moved_to_quarantine_untouched() {
+    let dir = scratch_dir("faults-random");
+    let data = dir.join("data");
+    let logs = data.join("mcap");
+    std::fs::create_dir_all(&logs).unwrap();
+    let name = "bearingd-20200101T000000Z-000000.mcap";
+    let bytes = noise(100_000, 11);
+    std::fs::write(logs.join(name), &bytes).unwrap();
+    // And a file with a valid start but not one complete record.
+    let mut stub = mcap::MAGIC.to_vec();
+    stub.extend(noise(50, 3));
+    let stub_name = "bearingd-20200101T000001Z-000000.mcap";
+    std::fs::write(logs.join(stub_name), &stub).unwrap();
+
+    let out = short_run(&data);
+    let stderr = stderr_of(&out);
+    assert!(out.status.success(), "{stderr}");
+    for (name, bytes) in [(name, &bytes), (stub_name, &stub)] {
+        assert!(!logs.join(name).exists(), "{name} is still among the logs");
+        let kept = std::fs::read(logs.join("quarantine").join(name)).unwrap();
+        assert_eq!(&kept, bytes, "{name} was changed");
+        assert!(
+            stderr.contains(name) && stderr.contains("quarantine"),
+            "{stderr}"
+        );
+    }
+    // The run's own log is fine.
+    let files = mcap_files(&logs);
+    assert_eq!(files.len(), 1, "{files:?}");
+    if let Some(py) = python_mcap() {
+        check_mcap_with_python(&py, &files[0], None);
+    }
+}
+
+#[test]
+fn a_log_damaged_in_the_middle_is_recovered_through_a_checked_copy_and_its_original_kept() {
+    let dir = scratch_dir("faults-damaged");
+    let data = dir.join("data");
+    let logs = data.join("mcap");
+    let out = bearingd(&[
+        "run",
+        "--fast",
+        "--duration",
+        "20",
+        "--quiet",
+        "--data-dir",
+        data.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let files = mcap_files(&logs);
+    assert_eq!(files.len(), 1);
+    let path = files[0].clone();
+    let intact = raw_blocks(&files);
+    // Cut the summary off (as a crash would) and flip a byte in a chunk near the middle.
+    let mut bytes = std::fs::read(&path).unwrap();
+    bytes.truncate(bytes.len() * 9 / 10);
+    let middle = bytes.len() / 2;
+    bytes[middle] ^= 0x5A;
+    std::fs::write(&path, &bytes).unwrap();
+
+    let out = short_run(&data);
+    let stderr = stderr_of(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("recovered") && stderr.contains("damaged original kept"),
+        "{stderr}"
+    );
+    let name = path.file_name().unwrap();
+    assert_eq!(
+        std::fs::read(logs.join("quarantine").join(name)).unwrap(),
+        bytes,
+        "the damaged original's bytes are kept"
+    );
+    let recovered = raw_blocks(std::slice::from_ref(&path));
+    assert!(
+        recovered > intact / 2 && recovered < intact,
+        "{recovered} of {intact} raw blocks recovered"
+    );
+    if let Some(py) = python_mcap() {
+        check_mcap_with_python(&py, &path, None);
+    }
+}
