@@ -239,3 +239,74 @@ fn a_log_damaged_in_the_middle_is_recovered_through_a_checked_copy_and_its_origi
         check_mcap_with_python(&py, &path, None);
     }
 }
+
+/// The embedded default's file with `edit` applied, written to `dir/bearingd.toml`.
+fn config_file(dir: &Path, edit: impl Fn(String) -> String) -> PathBuf {
+    let out = bearingd(&["config", "default"]);
+    assert!(out.status.success());
+    let text = edit(String::from_utf8(out.stdout).unwrap());
+    let path = dir.join("bearingd.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn baselines_are_saved_on_a_period_so_a_kill_9_keeps_them_and_the_restart_says_what_it_loaded() {
+    let dir = scratch_dir("faults-state");
+    let data = dir.join("data");
+    let root = format!("/dev/shm/bearingd-faults-{}", std::process::id());
+    let config = config_file(&dir, |text| {
+        let text = text
+            .replace(
+                "state_save_interval_s = 60.0",
+                "state_save_interval_s = 0.2",
+            )
+            .replace("\"/run/bearingd/iceoryx2\"", &format!("\"{root}\""));
+        assert!(text.contains("state_save_interval_s = 0.2"));
+        text
+    });
+    let args = |duration: &'static str| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_bearingd"));
+        cmd.args(["run", "--config", config.to_str().unwrap()])
+            .args(["--data-dir", data.to_str().unwrap()])
+            .args(["--fast", "--quiet", "--duration", duration]);
+        cmd
+    };
+    let mut child = args("100000")
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let saved = data.join("state/baselines.json");
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while !std::fs::read_to_string(&saved).is_ok_and(|t| t.contains("motor-de")) {
+        assert!(
+            Instant::now() < deadline,
+            "no baselines saved in {} while running",
+            saved.display()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    child.kill().unwrap(); // SIGKILL: no stop, no save at the end
+    let killed = child.wait_with_output().unwrap();
+    let stderr = stderr_of(&killed);
+    assert!(
+        stderr.contains("no saved health baselines") && stderr.contains("--data-dir overrides"),
+        "{stderr}"
+    );
+    let text = std::fs::read_to_string(&saved).unwrap();
+    let list: serde_json::Value = serde_json::from_str(&text).expect("a whole JSON file");
+    assert!(!list.as_array().unwrap().is_empty());
+    // --data-dir was honoured with --config: the logs are there too.
+    assert!(!mcap_files(&data.join("mcap")).is_empty());
+
+    let out = args("1").output().unwrap();
+    let stderr = stderr_of(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("loaded the health baselines of 1 channel(s)")
+            && stderr.contains(saved.to_str().unwrap()),
+        "{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}

@@ -5,6 +5,7 @@ use super::CliError;
 use crate::config::{self, Config};
 use crate::daemon::state::StateError;
 use crate::daemon::{run, DaemonEvent, Events, RunOptions};
+use crate::mcap_log::files::utc_text;
 use crate::messages::{HealthKind, PipelineMessage, SpeedSource};
 use crate::pipeline::{ChannelStatus, Sink, SinkError};
 use crate::sinks::mcap::{RecoveryAction, RecoveryReport};
@@ -23,7 +24,8 @@ pub struct RunArgs {
     /// Run simulated sensors as fast as the analysis allows instead of in real time.
     #[arg(long)]
     fast: bool,
-    /// Where to keep state and logs when no config is given (default ./bearingd-data).
+    /// Where to keep state (DIR/state) and logs (DIR/mcap); overrides outputs.state_dir and
+    /// outputs.mcap_dir of --config. Without --config, default ./bearingd-data.
     #[arg(long)]
     data_dir: Option<PathBuf>,
     /// No status lines (flags and the summary are still printed).
@@ -58,7 +60,21 @@ impl Sink for FlagPrinter {
 
 pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
     let config = match &args.config {
-        Some(path) => config::load(path).map_err(CliError::input)?,
+        Some(path) => {
+            let mut config = config::load(path).map_err(CliError::input)?;
+            if let Some(data) = &args.data_dir {
+                // The command line wins over the file, as without a config: the same layout.
+                config.outputs.state_dir = data.join("state");
+                config.outputs.mcap_dir = data.join("mcap");
+                eprintln!(
+                    "bearingd: --data-dir overrides outputs.state_dir and outputs.mcap_dir of {}: state in {}, logs in {}",
+                    path.display(),
+                    config.outputs.state_dir.display(),
+                    config.outputs.mcap_dir.display()
+                );
+            }
+            config
+        }
         None => embedded_default(args)?,
     };
     let options = RunOptions {
@@ -183,6 +199,20 @@ fn event_line(event: &DaemonEvent) -> String {
         DaemonEvent::SourceTaskFailed(error) => format!("bearingd: a source task failed: {error}"),
         DaemonEvent::UnknownChannel { channel, blocks } => format!(
             "bearingd: {blocks} blocks of {channel} skipped: no such sensor/axis in the config"
+        ),
+        DaemonEvent::StateLoaded(loaded) => format!(
+            "bearingd: loaded the health baselines of {} channel(s) from {}, saved {}",
+            loaded.channels,
+            loaded.path.display(),
+            if loaded.saved_at_ns == 0 {
+                "at an unknown time".to_string()
+            } else {
+                utc_text(loaded.saved_at_ns)
+            }
+        ),
+        DaemonEvent::NoState(dir) => format!(
+            "bearingd: no saved health baselines in {}: learning them from the start",
+            dir.display()
         ),
         DaemonEvent::State(problem @ StateError::Unreadable { .. }) => {
             format!("bearingd: warning: {problem}; health baselines are learned again")

@@ -162,4 +162,5 @@ pub(crate) struct RawOutputs {
     pub alerts_service: Field<String>,
     pub iceoryx2_root: Field<String>,
     pub status_interval_s: Field<f64>,
+    pub state_save_interval_s: Field<f64>,
 }

@@ -269,6 +269,9 @@ pub struct OutputConfig {
     pub iceoryx2_root: PathBuf,
     /// How often status is reported (systemd STATUS, stdout), in seconds.
     pub status_interval_s: f64,
+    /// How often the learned state (health baselines) is saved to `state_dir` while running,
+    /// in seconds of wall-clock time; it is also saved at every stop.
+    pub state_save_interval_s: f64,
 }
 
 impl OutputConfig {
@@ -294,6 +297,7 @@ impl Default for OutputConfig {
             alerts_service: "bearingd/alerts".to_string(),
             iceoryx2_root: PathBuf::from("/run/bearingd/iceoryx2"),
             status_interval_s: 5.0,
+            state_save_interval_s: 60.0,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! the caller gives ([`Events`]). The daemon never prints; the command line decides how each
 //! event reads (`crate::cli`), tests can collect them.
 
-use super::state::StateError;
+use super::state::{StateError, StateLoaded};
 use crate::mcap_log::McapLogError;
 use crate::messages::ChannelId;
 use crate::pipeline::ChannelStatus;
@@ -48,6 +48,10 @@ pub enum DaemonEvent {
     SourceTaskFailed(String),
     /// Sample blocks of a channel the config does not know were skipped.
     UnknownChannel { channel: ChannelId, blocks: u64 },
+    /// The health baselines kept across restarts were loaded at start.
+    StateLoaded(StateLoaded),
+    /// No saved state in this directory: the baselines are learned from the start.
+    NoState(PathBuf),
     /// The health baselines kept across restarts could not be read (they are learned again),
     /// or could not be saved at stop.
     State(StateError),

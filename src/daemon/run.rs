@@ -120,9 +120,11 @@ pub async fn run(
     let _locks = lock_data_dirs(&config, &events)?;
     sinks.push(Box::new(open_log(&config, &events)?));
     let alerts = start_alerts(&config, &events)?;
-    let (baselines, problem) = load_baselines(&state_dir);
-    if let Some(problem) = problem {
-        events(DaemonEvent::State(problem));
+    let (baselines, loaded) = load_baselines(&state_dir);
+    match loaded {
+        Ok(Some(loaded)) => events(DaemonEvent::StateLoaded(loaded)),
+        Ok(None) => events(DaemonEvent::NoState(state_dir.clone())),
+        Err(problem) => events(DaemonEvent::State(problem)),
     }
     let pipeline = Pipeline::new(&config, &baselines);
 
@@ -144,6 +146,8 @@ pub async fn run(
         status: status_tx,
         requests_skipped: 0,
         state_dir,
+        state_every: Duration::from_secs_f64(config.outputs.state_save_interval_s),
+        state_saved: std::time::Instant::now(),
         events: events.clone(),
     };
     let analysis = spawn("analysis", move || analysis.run())?;
@@ -328,6 +332,10 @@ struct AnalysisThread {
     status: watch::Sender<Vec<ChannelStatus>>,
     requests_skipped: u64,
     state_dir: PathBuf,
+    /// `outputs.state_save_interval_s`: the baselines are saved this often (wall-clock time,
+    /// on this thread, outside the analysis) and at the stop.
+    state_every: Duration,
+    state_saved: std::time::Instant,
     events: Events,
 }
 
@@ -339,8 +347,19 @@ impl AnalysisThread {
                 self.take_fit(fit);
             }
             self.status.send_replace(self.pipeline.status());
+            if self.state_saved.elapsed() >= self.state_every {
+                self.state_saved = std::time::Instant::now();
+                self.save_state();
+            }
         }
         self.stop()
+    }
+
+    /// Saves the learned state; a failure is reported, the run goes on.
+    fn save_state(&self) {
+        if let Err(problem) = save_baselines(&self.state_dir, &self.pipeline.baselines()) {
+            (self.events)(DaemonEvent::State(problem));
+        }
     }
 
     /// One input through the pipeline; its outputs to the sinks, the alerts and the re-fit.
@@ -396,9 +415,7 @@ impl AnalysisThread {
             self.take_fit(fit);
         }
         self.status.send_replace(self.pipeline.status());
-        if let Err(problem) = save_baselines(&self.state_dir, &self.pipeline.baselines()) {
-            (self.events)(DaemonEvent::State(problem));
-        }
+        self.save_state();
         for (channel, blocks) in self.pipeline.unknown_channels() {
             (self.events)(DaemonEvent::UnknownChannel {
                 channel: channel.clone(),

@@ -1,9 +1,15 @@
 //! What the daemon keeps across restarts in `outputs.state_dir`: the health baselines of every
 //! channel (`baselines.json`), so that a restart does not send the bearings back to learning.
+//!
+//! Saved every `outputs.state_save_interval_s` while running and at every stop, each time
+//! atomically (write a temporary file, fsync it, rename it over the old one, fsync the
+//! directory): a `kill -9` or a power cut finds either the previous save or the new one, never
+//! half a file, and loses at most one period of learning.
 
 use crate::analysis::health::Baseline;
 use crate::messages::ChannelId;
 use std::collections::BTreeMap;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 const BASELINES_FILE: &str = "baselines.json";
@@ -20,18 +26,44 @@ pub enum StateError {
     },
 }
 
+/// What was loaded at start, for the operator: which file, how many channels, saved when.
+#[derive(Debug, Clone)]
+pub struct StateLoaded {
+    pub path: PathBuf,
+    pub channels: usize,
+    /// The file's modification time, ns since the epoch (0 when unknown).
+    pub saved_at_ns: u64,
+}
+
 /// The baselines kept in `state_dir`: none when there is no file yet; an error (and none) when
 /// the file cannot be read, so the caller can say that the baselines are learned again.
-pub fn load_baselines(state_dir: &Path) -> (BTreeMap<ChannelId, Baseline>, Option<StateError>) {
+pub fn load_baselines(
+    state_dir: &Path,
+) -> (
+    BTreeMap<ChannelId, Baseline>,
+    Result<Option<StateLoaded>, StateError>,
+) {
     let path = state_dir.join(BASELINES_FILE);
     let Ok(text) = std::fs::read_to_string(&path) else {
-        return (BTreeMap::new(), None);
+        return (BTreeMap::new(), Ok(None));
     };
+    let saved_at_ns = std::fs::metadata(&path)
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+        .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX));
     match serde_json::from_str::<Vec<(ChannelId, Baseline)>>(&text) {
-        Ok(list) => (list.into_iter().collect(), None),
+        Ok(list) => {
+            let loaded = StateLoaded {
+                path,
+                channels: list.len(),
+                saved_at_ns,
+            };
+            (list.into_iter().collect(), Ok(Some(loaded)))
+        }
         Err(e) => (
             BTreeMap::new(),
-            Some(StateError::Unreadable {
+            Err(StateError::Unreadable {
                 path,
                 detail: e.to_string(),
             }),
@@ -39,8 +71,7 @@ pub fn load_baselines(state_dir: &Path) -> (BTreeMap<ChannelId, Baseline>, Optio
     }
 }
 
-/// Writes the baselines to `state_dir` (a temporary file renamed over the old one, so a crash
-/// never leaves half a file).
+/// Writes the baselines to `state_dir` atomically (see the module docs).
 pub fn save_baselines(
     state_dir: &Path,
     baselines: &BTreeMap<ChannelId, Baseline>,
@@ -48,9 +79,14 @@ pub fn save_baselines(
     let path = state_dir.join(BASELINES_FILE);
     let temporary = state_dir.join(format!("{BASELINES_FILE}.new"));
     let list: Vec<_> = baselines.iter().collect();
-    serde_json::to_string_pretty(&list)
-        .map_err(std::io::Error::other)
-        .and_then(|text| std::fs::write(&temporary, text))
-        .and_then(|_| std::fs::rename(&temporary, &path))
-        .map_err(|source| StateError::NotSaved { path, source })
+    let write = || -> std::io::Result<()> {
+        let text = serde_json::to_string_pretty(&list).map_err(std::io::Error::other)?;
+        let mut file = std::fs::File::create(&temporary)?;
+        file.write_all(text.as_bytes())?;
+        file.sync_all()?;
+        drop(file);
+        std::fs::rename(&temporary, &path)?;
+        std::fs::File::open(state_dir)?.sync_all()
+    };
+    write().map_err(|source| StateError::NotSaved { path, source })
 }

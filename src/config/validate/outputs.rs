@@ -111,6 +111,14 @@ impl Checker {
             Limits::above_to(0.0, 3600.0),
             "give how often status is reported, in seconds, e.g. status_interval_s = 5.0",
         );
+        let state_save_interval_s = self.number(
+            "outputs.state_save_interval_s",
+            &raw.state_save_interval_s,
+            d.state_save_interval_s,
+            Limits::above_to(0.0, 86_400.0),
+            "give how often the learned state is saved, in seconds, e.g. \
+             state_save_interval_s = 60.0",
+        );
         Some(OutputConfig {
             state_dir: state_dir?,
             mcap_dir: mcap_dir?,
@@ -120,6 +128,7 @@ impl Checker {
             alerts_service: alerts_service?,
             iceoryx2_root: iceoryx2_root?,
             status_interval_s: status_interval_s?,
+            state_save_interval_s: state_save_interval_s?,
         })
     }
 
