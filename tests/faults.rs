@@ -310,3 +310,108 @@ fn baselines_are_saved_on_a_period_so_a_kill_9_keeps_them_and_the_restart_says_w
     );
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// What `tests/python/log_metadata.py` (Python `mcap`, strict) reads from `file`.
+fn python_metadata(py: &Path, file: &Path) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/log_metadata.py");
+    let out = Command::new(py).arg(script).arg(file).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}: {}",
+        file.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn now_ns() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos() as u64
+}
+
+#[test]
+fn every_log_file_describes_itself_in_metadata_that_python_reads_also_after_rotation_and_recovery()
+{
+    let Some(py) = python_mcap() else { return };
+    let dir = scratch_dir("faults-metadata");
+    let data = dir.join("data");
+    let root = format!("/dev/shm/bearingd-faults-md-{}", std::process::id());
+    let config = config_file(&dir, |text| {
+        text.replace("mcap_max_file_s = 3600", "mcap_max_file_s = 1")
+            .replace("\"/run/bearingd/iceoryx2\"", &format!("\"{root}\""))
+    });
+    let before = now_ns();
+    let out = bearingd(&[
+        "run",
+        "--config",
+        config.to_str().unwrap(),
+        "--data-dir",
+        data.to_str().unwrap(),
+        "--fast",
+        "--quiet",
+        "--duration",
+        "3.5",
+    ]);
+    let _ = std::fs::remove_dir_all(&root);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let files = mcap_files(&data.join("mcap"));
+    assert!(
+        files.len() >= 3,
+        "rotation every second of log time: {files:?}"
+    );
+    let mut run_ids = Vec::new();
+    for (i, file) in files.iter().enumerate() {
+        let read = python_metadata(&py, file);
+        let md = &read["metadata"];
+        let run = &md["bearingd.run"][0];
+        assert_eq!(run["version"], env!("CARGO_PKG_VERSION"), "{read}");
+        assert!(!run["host"].as_str().unwrap().is_empty());
+        run_ids.push(run["run_id"].clone());
+        let origin: u64 = run["log_time_origin_ns"].as_str().unwrap().parse().unwrap();
+        assert!(origin >= before && origin <= now_ns(), "{read}");
+        assert!(run["log_time_origin_utc"].as_str().unwrap().ends_with('Z'));
+        // Log times are real UTC: at or after the origin, within the run's 3.5 s of signal.
+        let first = read["first_log_time"].as_u64().unwrap();
+        let last = read["last_log_time"].as_u64().unwrap();
+        assert!(first >= origin && last <= origin + 4_000_000_000, "{read}");
+        let channel = &md["bearingd.channel"][0];
+        assert_eq!(channel["channel"], "motor-de/radial", "{read}");
+        assert_eq!(channel["topic"], "/raw/motor-de/radial");
+        assert_eq!(channel["sample_rate_hz"], "25600");
+        assert_eq!(channel["unit"], "g");
+        assert_eq!(channel["bearing"], "skf-6205-2rs");
+        let geometry: serde_json::Value =
+            serde_json::from_str(channel["bearing_geometry"].as_str().unwrap()).unwrap();
+        assert_eq!(geometry["rolling_elements"], 9, "{geometry}");
+        let config: serde_json::Value =
+            serde_json::from_str(md["bearingd.config"][0]["json"].as_str().unwrap()).unwrap();
+        assert_eq!(config["sensors"][0]["sample_rate_hz"], 25600.0);
+        assert_eq!(
+            md["bearingd.file"][0]["sequence"],
+            (i + 1).to_string(),
+            "{read}"
+        );
+    }
+    assert!(run_ids.windows(2).all(|w| w[0] == w[1]), "{run_ids:?}");
+
+    // A file recovered after a kill -9 keeps its metadata.
+    let killed_data = dir.join("killed");
+    let mut child = start_daemon(&killed_data);
+    wait_for_log(&killed_data, 20_000);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let killed = mcap_files(&killed_data.join("mcap"));
+    let out = short_run(&killed_data);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+    let read = python_metadata(&py, &killed[0]);
+    assert_eq!(
+        read["metadata"]["bearingd.file"][0]["sequence"], "1",
+        "{read}"
+    );
+    assert_eq!(
+        read["metadata"]["bearingd.channel"][0]["sample_rate_hz"],
+        "25600"
+    );
+}

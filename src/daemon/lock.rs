@@ -12,6 +12,7 @@
 //! caller is told whose it was. A clean stop empties the file, so the next start says nothing.
 
 use crate::mcap_log::files::utc_text;
+use crate::sinks::mcap::metadata::host_name;
 use crate::sources::wall_clock_now_ns;
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Seek, SeekFrom, Write};
@@ -111,15 +112,6 @@ fn holder_text(text: &str) -> String {
         "" => "its pid is not written yet".to_string(),
         line => line.to_string(),
     }
-}
-
-/// This machine's name, as the kernel has it (`unknown` when it cannot be read).
-pub fn host_name() -> String {
-    std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .map(|h| h.trim().to_string())
-        .ok()
-        .filter(|h| !h.is_empty())
-        .unwrap_or_else(|| "unknown".to_string())
 }
 
 #[cfg(test)]

@@ -176,6 +176,7 @@ impl LogReader {
                 self.channels.insert(id, ChannelInfo { topic, decoder });
                 None
             }
+            ScannedRecord::Metadata { .. } => None,
             ScannedRecord::Message {
                 channel_id,
                 sequence,

@@ -33,6 +33,7 @@ const OP_SCHEMA: u8 = 0x03;
 const OP_CHANNEL: u8 = 0x04;
 const OP_MESSAGE: u8 = 0x05;
 const OP_CHUNK: u8 = 0x06;
+const OP_METADATA: u8 = 0x0C;
 
 /// A schema, channel or message read from a file, owned.
 #[derive(Debug, Clone)]
@@ -48,6 +49,11 @@ pub enum ScannedRecord {
         schema_id: u16,
         topic: String,
         message_encoding: String,
+        metadata: BTreeMap<String, String>,
+    },
+    /// A metadata record (top level, between chunks).
+    Metadata {
+        name: String,
         metadata: BTreeMap<String, String>,
     },
     Message {
@@ -235,7 +241,7 @@ impl Scanner {
                 }
                 Err(reason) => self.skip_chunk(start, len, &reason),
             },
-            OP_SCHEMA | OP_CHANNEL | OP_MESSAGE => match own(opcode, &body, start) {
+            OP_SCHEMA | OP_CHANNEL | OP_MESSAGE | OP_METADATA => match own(opcode, &body, start) {
                 Ok(Some(r)) => self.pending.push_back(r),
                 Ok(None) => {}
                 Err(e) => {
@@ -246,7 +252,7 @@ impl Scanner {
                     }
                 }
             },
-            // Indexes, statistics, attachments, metadata: not needed to read messages in order.
+            // Indexes, statistics, attachments: not needed to read messages in order.
             _ => {}
         }
         Ok(())
@@ -263,7 +269,7 @@ impl Scanner {
 
 /// Parses one schema, channel or message record body; other opcodes give `Ok(None)`.
 fn own(opcode: u8, body: &[u8], offset: u64) -> std::result::Result<Option<ScannedRecord>, String> {
-    if !matches!(opcode, OP_SCHEMA | OP_CHANNEL | OP_MESSAGE) {
+    if !matches!(opcode, OP_SCHEMA | OP_CHANNEL | OP_MESSAGE | OP_METADATA) {
         return Ok(None);
     }
     let record = mcap::parse_record(opcode, body)
@@ -281,6 +287,10 @@ fn own(opcode: u8, body: &[u8], offset: u64) -> std::result::Result<Option<Scann
             topic: c.topic,
             message_encoding: c.message_encoding,
             metadata: c.metadata,
+        }),
+        Record::Metadata(m) => Some(ScannedRecord::Metadata {
+            name: m.name,
+            metadata: m.metadata,
         }),
         Record::Message { header, data } => Some(ScannedRecord::Message {
             channel_id: header.channel_id,

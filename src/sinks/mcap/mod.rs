@@ -2,8 +2,10 @@
 //! start-up recovery of files a crash left unfinished ([`recover`]), and [`McapSink`], which
 //! maps sample time to log time, flushes the open chunk every second of data (a crash loses at
 //! most that), recovers unfinished files at start, and finishes the file at shutdown. The
-//! format itself (schemas, topics, file names, reading back) is [`crate::mcap_log`].
+//! format itself (schemas, topics, file names, reading back) is [`crate::mcap_log`]; what each
+//! file says about itself in MCAP metadata records is [`metadata`].
 
+pub mod metadata;
 pub mod recover;
 pub mod writer;
 
@@ -63,13 +65,18 @@ impl McapSink {
         ))
     }
 
-    /// [`open`](Self::open) with the log settings of `config`'s `[outputs]` and its sensors'
-    /// sample rates.
+    /// [`open`](Self::open) with the log settings of `config`'s `[outputs]`, its sensors'
+    /// sample rates, and the metadata that makes each file self-describing
+    /// ([`metadata::run_records`]; the run is named by `origin_ns`).
     pub fn for_config(
         config: &Config,
         origin_ns: u64,
     ) -> Result<(Self, Vec<RecoveryReport>), McapLogError> {
-        McapSink::open(logger_config(config), config.sample_rates(), origin_ns)
+        let logger = LoggerConfig {
+            metadata: metadata::run_records(config, origin_ns, origin_ns),
+            ..logger_config(config)
+        };
+        McapSink::open(logger, config.sample_rates(), origin_ns)
     }
 
     pub fn current_path(&self) -> Option<&Path> {

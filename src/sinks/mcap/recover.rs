@@ -278,6 +278,12 @@ fn copy_readable_records(path: &Path, temp: &Path) -> Result<(Copied, ScanOutcom
                     copied.records += 1;
                 }
             }
+            ScannedRecord::Metadata { name, metadata } => {
+                writer
+                    .write_metadata(&mcap::records::Metadata { name, metadata })
+                    .map_err(werr)?;
+                copied.records += 1;
+            }
             ScannedRecord::Message {
                 channel_id,
                 sequence,

@@ -44,18 +44,24 @@ pub struct LoggerConfig {
     pub disk_budget_bytes: u64,
     /// zstd level (1..=19); 3 is zstd's default and keeps up easily on an edge CPU.
     pub zstd_level: u32,
+    /// MCAP metadata records written at the start of every file (what makes a file
+    /// self-describing: see [`super::metadata`]); each file also gets a `bearingd.file` record
+    /// with its sequence number in the run.
+    pub metadata: Vec<(String, BTreeMap<String, String>)>,
 }
 
 impl LoggerConfig {
-    /// Defaults for a directory: 4 MiB chunks, 256 MiB or 1 h files, 8 GiB budget, zstd 3.
+    /// Defaults for a directory: 4 MiB chunks, 256 MiB or 1 h files, 4 GiB budget (the
+    /// config's default `mcap_disk_budget_mb = 4096`), zstd 3, no metadata.
     pub fn new(dir: impl Into<PathBuf>) -> Self {
         LoggerConfig {
             dir: dir.into(),
             chunk_size: 4 * 1024 * 1024,
             max_file_bytes: 256 * 1024 * 1024,
             max_file_duration_ns: 3600 * 1_000_000_000,
-            disk_budget_bytes: 8 * 1024 * 1024 * 1024,
+            disk_budget_bytes: 4 * 1024 * 1024 * 1024,
             zstd_level: 3,
+            metadata: Vec::new(),
         }
     }
 
@@ -175,7 +181,13 @@ impl OpenFile {
         self.len.load(Ordering::Relaxed)
     }
 
-    fn create(dir: &Path, opened_at_ns: u64, seq: &mut u32, config: &LoggerConfig) -> Result<Self> {
+    fn create(
+        dir: &Path,
+        opened_at_ns: u64,
+        seq: &mut u32,
+        file_in_run: u64,
+        config: &LoggerConfig,
+    ) -> Result<Self> {
         // Never overwrite: a restart within the same second reuses a name, so bump the sequence.
         let mut tries = 0;
         let (path, file) = loop {
@@ -193,17 +205,27 @@ impl OpenFile {
             pos: 0,
             len: Arc::clone(&len),
         };
-        let writer = WriteOptions::new()
+        let werr = |source| McapLogError::Write {
+            path: path.clone(),
+            source,
+        };
+        let mut writer = WriteOptions::new()
             .profile("")
             .library(concat!("bearingd ", env!("CARGO_PKG_VERSION")))
             .compression(Some(Compression::Zstd))
             .compression_level(config.zstd_level)
             .chunk_size(Some(config.chunk_size))
             .create(stream)
-            .map_err(|source| McapLogError::Write {
-                path: path.clone(),
-                source,
-            })?;
+            .map_err(werr)?;
+        let file_record = super::metadata::file_record(file_in_run, opened_at_ns);
+        for (name, metadata) in config.metadata.iter().chain(std::iter::once(&file_record)) {
+            writer
+                .write_metadata(&mcap::records::Metadata {
+                    name: name.clone(),
+                    metadata: metadata.clone(),
+                })
+                .map_err(werr)?;
+        }
         Ok(OpenFile {
             path,
             writer,
@@ -319,7 +341,13 @@ impl McapLogger {
     }
 
     fn open_file(&mut self, opened_at_ns: u64) -> Result<()> {
-        let file = OpenFile::create(&self.config.dir, opened_at_ns, &mut self.seq, &self.config)?;
+        let file = OpenFile::create(
+            &self.config.dir,
+            opened_at_ns,
+            &mut self.seq,
+            self.stats.files_opened + 1,
+            &self.config,
+        )?;
         self.open = Some(file);
         self.stats.files_opened += 1;
         Ok(())
