@@ -415,3 +415,88 @@ fn every_log_file_describes_itself_in_metadata_that_python_reads_also_after_rota
         "25600"
     );
 }
+
+/// Seconds of signal the embedded default's log holds in `file`, contiguous from sample 0
+/// (asserted), and the log-time origin the file names.
+fn logged_signal(py: &Path, file: &Path) -> (f64, u64) {
+    let mut next = 0u64;
+    let mut rate = 0.0;
+    for m in read_messages(&[file]) {
+        if let PipelineMessage::Raw(b) = m.unwrap().message {
+            assert_eq!(
+                b.first_sample,
+                next,
+                "{}: a hole in the raw samples",
+                file.display()
+            );
+            next += b.counts.len() as u64;
+            rate = b.sample_rate_hz;
+        }
+    }
+    let read = python_metadata(py, file);
+    let origin = read["metadata"]["bearingd.run"][0]["log_time_origin_ns"]
+        .as_str()
+        .unwrap()
+        .parse()
+        .unwrap();
+    (next as f64 / rate.max(1.0), origin)
+}
+
+/// `kill -9` of a real-time daemon at 20 seeded random moments: each time the restart
+/// recovers the file, Python's strict reader reads it, its raw samples are contiguous from
+/// the start, and the signal lost (from the last recovered sample to the kill) is at most the
+/// last unflushed second plus the block in flight. Prints the losses for docs/OPERATIONS.md.
+#[test]
+fn kill_9_at_20_random_moments_loses_at_most_the_last_unflushed_second() {
+    let Some(py) = python_mcap() else { return };
+    const SEEDS: u64 = 20;
+    let dir = scratch_dir("faults-kill9");
+    let losses: Vec<(u64, f64, f64)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..4u64)
+            .map(|worker| {
+                let (dir, py) = (&dir, &py);
+                scope.spawn(move || {
+                    let mut out = Vec::new();
+                    for seed in (worker..SEEDS).step_by(4) {
+                        let data = dir.join(format!("seed-{seed}"));
+                        let mut child = start_daemon(&data);
+                        wait_for_log(&data, 1);
+                        // 0.2 to 3.2 s after the first flush reached the disk.
+                        let wait_ms = 200
+                            + noise(2, seed + 1)
+                                .iter()
+                                .fold(0u64, |a, &b| a * 256 + u64::from(b))
+                                % 3000;
+                        std::thread::sleep(Duration::from_millis(wait_ms));
+                        child.kill().unwrap();
+                        let killed_at = now_ns();
+                        child.wait().unwrap();
+                        let files = mcap_files(&data.join("mcap"));
+                        assert_eq!(files.len(), 1, "{files:?}");
+                        let out_run = short_run(&data);
+                        assert!(out_run.status.success(), "{}", stderr_of(&out_run));
+                        check_mcap_with_python(py, &files[0], None);
+                        let (seconds, origin) = logged_signal(py, &files[0]);
+                        let lived = (killed_at - origin) as f64 / 1e9;
+                        out.push((seed, lived, lived - seconds));
+                    }
+                    out
+                })
+            })
+            .collect();
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().unwrap())
+            .collect()
+    });
+    assert_eq!(losses.len() as u64, SEEDS);
+    let worst = losses.iter().map(|l| l.2).fold(0.0, f64::max);
+    let mean = losses.iter().map(|l| l.2).sum::<f64>() / SEEDS as f64;
+    eprintln!(
+        "kill -9 at {SEEDS} moments: signal lost mean {mean:.2} s, worst {worst:.2} s; (seed, s logged before the kill, s lost): {losses:.2?}"
+    );
+    assert!(
+        worst <= 2.0,
+        "lost up to {worst:.2} s of signal: {losses:.2?}"
+    );
+}
