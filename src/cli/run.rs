@@ -181,6 +181,17 @@ fn event_line(event: &DaemonEvent) -> String {
             "bearingd: {}: taken over from a previous bearingd that did not stop cleanly ({previous})",
             path.display()
         ),
+        DaemonEvent::Retention(report) => format!(
+            "bearingd: retention: deleted {} ({} bytes) to keep the logs within outputs.mcap_disk_budget_mb; {} bytes of logs left",
+            report
+                .deleted
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            report.bytes_deleted,
+            report.total_bytes_after
+        ),
         DaemonEvent::LoggingTo(path) => format!("bearingd: logging to {}", path.display()),
         DaemonEvent::AlertsOn { service, root } => format!(
             "bearingd: alerts on iceoryx2 service {service} (root {})",

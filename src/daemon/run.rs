@@ -236,6 +236,10 @@ fn lock_data_dirs(config: &Config, events: &Events) -> Result<Vec<DirLock>, RunE
 /// Recovers what a crash left in the log directory and opens the log, sample 0 at now.
 fn open_log(config: &Config, events: &Events) -> Result<McapSink, RunError> {
     let (log, recovered) = McapSink::for_config(config, wall_clock_now_ns())?;
+    let log = {
+        let events = events.clone();
+        log.on_retention(move |report| events(DaemonEvent::Retention(report.clone())))
+    };
     for report in recovered {
         events(DaemonEvent::Recovered(report));
     }

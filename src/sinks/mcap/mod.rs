@@ -34,6 +34,8 @@ pub struct McapSink {
     last_ns: u64,
     errors: Vec<String>,
     pub messages: u64,
+    /// Told of every retention pass that deleted files (the operator must know).
+    on_retention: Box<dyn Fn(&RetentionReport) + Send>,
 }
 
 impl McapSink {
@@ -60,6 +62,7 @@ impl McapSink {
                 last_ns: origin_ns,
                 errors: Vec::new(),
                 messages: 0,
+                on_retention: Box::new(|_| {}),
             },
             recovered,
         ))
@@ -77,6 +80,22 @@ impl McapSink {
             ..logger_config(config)
         };
         McapSink::open(logger, config.sample_rates(), origin_ns)
+    }
+
+    /// Calls `report` for every retention pass that deleted files: the one at start (now) and
+    /// those after each rotation.
+    pub fn on_retention(mut self, report: impl Fn(&RetentionReport) + Send + 'static) -> Self {
+        if let Some(startup) = self
+            .logger
+            .as_mut()
+            .and_then(|l| l.take_startup_retention())
+        {
+            if !startup.deleted.is_empty() {
+                report(&startup);
+            }
+        }
+        self.on_retention = Box::new(report);
+        self
     }
 
     pub fn current_path(&self) -> Option<&Path> {
@@ -109,7 +128,12 @@ impl Sink for McapSink {
             return;
         };
         match logger.log(message, time, time) {
-            Ok(_) => self.messages += 1,
+            Ok(retention) => {
+                self.messages += 1;
+                if let Some(report) = retention.filter(|r| !r.deleted.is_empty()) {
+                    (self.on_retention)(&report);
+                }
+            }
             Err(e) if self.errors.len() < 10 => self.errors.push(e.to_string()),
             Err(_) => {}
         }

@@ -316,6 +316,8 @@ pub struct McapLogger {
     stats: LogStats,
     topic: String,
     payload: Vec<u8>,
+    /// What the retention pass at creation deleted, until the owner takes it.
+    startup_retention: Option<RetentionReport>,
 }
 
 impl McapLogger {
@@ -334,9 +336,10 @@ impl McapLogger {
             stats: LogStats::default(),
             topic: String::with_capacity(64),
             payload: Vec::with_capacity(64 * 1024),
+            startup_retention: None,
         };
         logger.open_file(opened_at_ns)?;
-        logger.apply_retention()?;
+        logger.startup_retention = Some(logger.apply_retention()?);
         Ok(logger)
     }
 
@@ -351,6 +354,11 @@ impl McapLogger {
         self.open = Some(file);
         self.stats.files_opened += 1;
         Ok(())
+    }
+
+    /// What the retention pass at creation did (once; `None` afterwards).
+    pub fn take_startup_retention(&mut self) -> Option<RetentionReport> {
+        self.startup_retention.take()
     }
 
     /// The file being written.
