@@ -543,3 +543,28 @@ fn retention_says_which_files_it_deleted() {
         );
     }
 }
+
+#[test]
+fn replay_of_a_file_that_is_not_mcap_exits_2_naming_it() {
+    let dir = scratch_dir("faults-replay-junk");
+    for (name, bytes) in [
+        ("junk.mcap", noise(4096, 7)),
+        ("short.mcap", b"MCAP".to_vec()),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let out = bearingd(&[
+            "replay",
+            path.to_str().unwrap(),
+            "--out",
+            dir.join("out").to_str().unwrap(),
+            "--quiet",
+        ]);
+        let stderr = stderr_of(&out);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(
+            stderr.contains(name) && stderr.contains("not an MCAP log"),
+            "{stderr}"
+        );
+    }
+}

@@ -8,7 +8,7 @@ use crate::daemon::{replay, ReplayOptions};
 use crate::pipeline::Sink;
 use crate::sinks::mcap::McapSink;
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct ReplayArgs {
@@ -51,6 +51,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
                 file.display()
             )));
         }
+        check_mcap_magic(file)?;
     }
     config.outputs.mcap_dir = args.out.clone();
     // The output directory has one owner too: recovery at open would otherwise rewrite the
@@ -111,4 +112,20 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// Refuses a file that does not start with the MCAP magic: replaying it would read nothing and
+/// succeed, which looks like an empty log rather than the wrong file.
+fn check_mcap_magic(file: &Path) -> Result<(), CliError> {
+    use std::io::Read;
+    let mut magic = [0u8; 8];
+    let read = std::fs::File::open(file).and_then(|mut f| f.read_exact(&mut magic));
+    match read {
+        Ok(()) if magic == *mcap::MAGIC => Ok(()),
+        Ok(()) | Err(_) => Err(CliError::input(format!(
+            "{}: not an MCAP log (it does not start with the MCAP magic bytes); give a log \
+             written by `bearingd run` or `bearingd import` (a .mcap file)",
+            file.display()
+        ))),
+    }
 }
