@@ -6,12 +6,20 @@
 //! `replay` alike, and its outputs depend only on its inputs, so a replay of the logged raw
 //! samples gives the same flags at the same samples.
 //!
+//! One exception to "single-threaded": band selections run on the [`bands`] worker thread,
+//! their results used a fixed sample-time delay ([`band_delay_s`]) after they started, so the
+//! outputs still depend only on the inputs.
+//!
 //! [`Sink`] is the seam to the sinks: the pipeline's messages go to whatever implements it
 //! (the MCAP log, the command line's flag printer), and the pipeline knows none of them.
 
+mod background;
+pub mod bands;
 pub mod refit;
 mod sink;
+pub mod twin_queue;
 
+pub use background::lower_this_threads_priority;
 pub use refit::TwinWorker;
 pub use sink::{Sink, SinkError};
 
@@ -201,6 +209,16 @@ pub fn band_history_s(config: &Config) -> f64 {
 
 const MAX_BAND_HISTORY_S: f64 = 10.0;
 
+/// Seconds of sample time from a band selection's start (on the worker thread) to the sample
+/// where its bands are used: 2 s, or half the band period if that is shorter. Long enough for
+/// the worker to finish the selections of many channels (30–100 ms each) before the analysis
+/// needs them; short against the band period (default 20 s) and the flags' delays.
+pub fn band_delay_s(config: &Config) -> f64 {
+    (config.band_period_s / 2.0).min(MAX_BAND_DELAY_S)
+}
+
+const MAX_BAND_DELAY_S: f64 = 2.0;
+
 impl Channel {
     /// A speed given from outside, at `at_sample` of this channel.
     fn speed_at(
@@ -231,6 +249,7 @@ impl Pipeline {
         let mut channels = BTreeMap::new();
         let turns: usize = config.sensors.iter().map(|s| s.axes.len()).sum();
         let mut turn = 0;
+        let worker = bands::BandWorker::start(turns);
         for sensor in &config.sensors {
             // Without a starting speed the channel waits (nothing is scored); its frequencies
             // are then those at the highest speed, for sizing only.
@@ -244,11 +263,21 @@ impl Pipeline {
                     sensor: sensor.id.clone(),
                     axis: axis.clone(),
                 };
-                let monitor = ChannelMonitor::new(
+                let mut monitor = ChannelMonitor::new(
                     monitor_settings(config, sensor, turn, turns),
                     freqs,
                     baselines.get(&id).cloned(),
                 );
+                if let Some(worker) = &worker {
+                    // The channels' first selections (all when their histories fill) are
+                    // spread over the delay, so the worker has them done in time.
+                    let delay = band_delay_s(config) * sensor.sample_rate_hz;
+                    monitor = monitor.with_band_selector(
+                        Box::new(worker.selector()),
+                        delay.round() as u64,
+                        (delay * turn as f64 / turns.max(1) as f64).round() as u64,
+                    );
+                }
                 turn += 1;
                 let status = ChannelStatus {
                     channel: id.clone(),
