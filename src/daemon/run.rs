@@ -37,9 +37,7 @@ use crate::config::{Config, Transport};
 use crate::mcap_log::McapLogError;
 use crate::messages::{FlagMessage, PipelineMessage, TwinMessage};
 use crate::pipeline::twin_queue::{twin_requests, TwinRequestQueue, TwinRequests};
-use crate::pipeline::{
-    lower_this_threads_priority, ChannelStatus, Output, Pipeline, Sink, SinkError, TwinWorker,
-};
+use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinWorker};
 use crate::sinks::alerts::PublisherSummary;
 use crate::sinks::mcap::McapSink;
 use crate::sinks::systemd::{keep_alive, status_text, Notifier};
@@ -394,7 +392,6 @@ impl AnalysisThread {
 /// The re-fit thread: one request at a time, each fit handed back to the analysis thread.
 /// Returns the number of fits made.
 fn refit_thread(requests: &TwinRequestQueue, fits: &mpsc::SyncSender<TwinMessage>) -> u64 {
-    lower_this_threads_priority();
     let mut worker = TwinWorker::default();
     let mut made = 0u64;
     while let Some(request) = requests.take() {
@@ -414,7 +411,6 @@ fn sink_thread(
     mut sinks: Vec<Box<dyn Sink>>,
     messages: &mpsc::Receiver<PipelineMessage>,
 ) -> Result<(Vec<FlagMessage>, u64), SinkError> {
-    lower_this_threads_priority();
     let mut flags = Vec::new();
     let mut count = 0u64;
     while let Ok(message) = messages.recv() {

@@ -32,7 +32,6 @@ impl BandWorker {
         std::thread::Builder::new()
             .name("bearingd-bands".into())
             .spawn(move || {
-                super::lower_this_threads_priority();
                 // Its own plans: the shared cache's lock is then never held for a selection.
                 let mut plans = FftPlans::default();
                 while let Ok((job, result)) = requests.recv() {

@@ -13,13 +13,11 @@
 //! [`Sink`] is the seam to the sinks: the pipeline's messages go to whatever implements it
 //! (the MCAP log, the command line's flag printer), and the pipeline knows none of them.
 
-mod background;
 pub mod bands;
 pub mod refit;
 mod sink;
 pub mod twin_queue;
 
-pub use background::lower_this_threads_priority;
 pub use refit::TwinWorker;
 pub use sink::{Sink, SinkError};
 
