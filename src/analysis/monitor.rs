@@ -247,7 +247,7 @@ impl ChannelMonitor {
                 window,
                 hop,
                 settings.analysis.averages,
-                &[whole; 4],
+                &[],
                 bins,
             ),
             scorer,

@@ -217,6 +217,10 @@ pub fn band_delay_s(config: &Config) -> f64 {
 
 const MAX_BAND_DELAY_S: f64 = 2.0;
 
+/// Seconds of sample time between the first band selections of two channels (a selection
+/// takes 30–100 ms; each holds a copy of its channel's history until it is done).
+const FIRST_SELECTION_SPACING_S: f64 = 0.25;
+
 impl Channel {
     /// A speed given from outside, at `at_sample` of this channel.
     fn speed_at(
@@ -267,13 +271,16 @@ impl Pipeline {
                     baselines.get(&id).cloned(),
                 );
                 if let Some(worker) = &worker {
-                    // The channels' first selections (all when their histories fill) are
-                    // spread over the delay, so the worker has them done in time.
-                    let delay = band_delay_s(config) * sensor.sample_rate_hz;
+                    // The channels' first selections (all due when their histories fill) take
+                    // turns, FIRST_SELECTION_SPACING_S apart (within one band period), so that
+                    // the worker is not handed every channel's history at once.
+                    let fs = sensor.sample_rate_hz;
+                    let spacing_s =
+                        FIRST_SELECTION_SPACING_S.min(config.band_period_s / turns.max(1) as f64);
                     monitor = monitor.with_band_selector(
                         Box::new(worker.selector()),
-                        delay.round() as u64,
-                        (delay * turn as f64 / turns.max(1) as f64).round() as u64,
+                        (band_delay_s(config) * fs).round() as u64,
+                        (spacing_s * turn as f64 * fs).round() as u64,
                     );
                 }
                 turn += 1;
