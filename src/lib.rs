@@ -16,7 +16,8 @@
 //! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
 //! - [`pipeline`]: the per-channel pipeline shared by `run` and `replay`, its outputs, the twin's
-//!   re-fit requests and the [`Sink`](pipeline::Sink) trait, the seam to the sinks.
+//!   re-fit requests (served per channel in turn), the band-selection worker and the
+//!   [`Sink`](pipeline::Sink) trait, the seam to the sinks.
 //! - [`config`]: the TOML configuration, parsed raw then validated into typed settings (one file
 //!   per section), with every problem reported at once.
 //! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the

@@ -15,6 +15,7 @@
 //! - [`iso`]: velocity severity and zones after ISO 10816-3 / 20816-3.
 
 pub mod band;
+pub mod band_selection;
 pub mod diagnosis;
 pub mod envelope;
 pub mod fault_bands;

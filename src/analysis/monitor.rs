@@ -27,17 +27,23 @@
 //!   effect at a sample, so a replay that feeds the logged changes at their samples repeats
 //!   every event.
 //!
+//! - Band selections run as jobs ([`super::band_selection`]): inline by default; with
+//!   [`ChannelMonitor::with_band_selector`] on another thread, their results used a fixed number
+//!   of samples after they started, so that the analysis never waits 30–100 ms for one.
+//!
 //! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
 
+use super::band_selection::{
+    scaled, usable_shaft_hz, BandJob, BandResult, BandSelector, InlineSelector,
+};
 use super::diagnosis::Contest;
-use super::envelope::FftPlans;
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::{FaultFlag, FlagChange, FlagSettings};
 use super::health::{Baseline, HealthTracker, StageChange};
 use super::indicators::Indicators;
-use super::record::{analyze_with_plans, envelope_range_hz};
-use super::speed::{estimate_shaft_hz, SpeedSearch};
+use super::record::envelope_range_hz;
+use super::speed::SpeedSearch;
 use super::{AnalysisSettings, Band};
 use crate::bearing::FaultFrequencies;
 use crate::messages::{FaultKind, FlagLevel, HealthKind};
@@ -83,7 +89,7 @@ pub enum SpeedMode {
 
 impl SpeedMode {
     /// The highest shaft rate the channel analyses, given the starting one.
-    fn max_shaft_hz(&self, start_hz: f64) -> f64 {
+    pub(crate) fn max_shaft_hz(&self, start_hz: f64) -> f64 {
         match *self {
             SpeedMode::Fixed => start_hz,
             SpeedMode::Given { max_shaft_hz, .. } => max_shaft_hz.max(start_hz),
@@ -195,6 +201,12 @@ pub struct ChannelMonitor {
     flat: bool,
     flat_since: u64,
     last_count: Option<i32>,
+    /// Runs the band selections ([`InlineSelector`] unless given one).
+    band_selector: Box<dyn BandSelector>,
+    /// Samples from a band selection's start to the sample where its result is used.
+    band_delay_samples: u64,
+    /// Where the band selection under way (if any) is used.
+    band_result_at: Option<u64>,
 }
 
 /// Samples converted per chunk (the scratch buffer's size).
@@ -235,7 +247,7 @@ impl ChannelMonitor {
                 window,
                 hop,
                 settings.analysis.averages,
-                &[whole; 4],
+                &[],
                 bins,
             ),
             scorer,
@@ -258,12 +270,31 @@ impl ChannelMonitor {
             flat: false,
             flat_since: 0,
             last_count: None,
+            band_selector: Box::new(InlineSelector::default()),
+            band_delay_samples: 0,
+            band_result_at: None,
             freqs,
             orders,
             speed_known,
             pending_speed: None,
             settings,
         }
+    }
+
+    /// Runs the band selections with `selector` and uses each result `delay_samples` after the
+    /// selection started (0: at once, as inline); the first selection comes
+    /// `first_extra_samples` later than when the history is full (to spread the first
+    /// selections of many channels over the delay).
+    pub fn with_band_selector(
+        mut self,
+        selector: Box<dyn BandSelector>,
+        delay_samples: u64,
+        first_extra_samples: u64,
+    ) -> Self {
+        self.band_selector = selector;
+        self.band_delay_samples = delay_samples;
+        self.next_band_selection += first_extra_samples;
+        self
     }
 
     pub fn frequencies(&self) -> &FaultFrequencies {
@@ -308,7 +339,7 @@ impl ChannelMonitor {
         on_event: &mut impl FnMut(MonitorEvent),
     ) {
         let max = self.settings.speed.max_shaft_hz(self.freqs.shaft);
-        let usable = given.filter(|&hz| hz.is_finite() && hz > 0.0 && hz <= max * (1.0 + 1e-9));
+        let usable = usable_shaft_hz(given, max);
         let was_known = self.speed_known;
         if let Some(hz) = usable {
             self.freqs = scaled(&self.orders, hz);
@@ -326,7 +357,7 @@ impl ChannelMonitor {
             && !self.bands_known
             && self.history_filled == self.history.len()
         {
-            self.select_bands(on_event);
+            self.start_band_selection(on_event);
         }
     }
 
@@ -366,6 +397,10 @@ impl ChannelMonitor {
         on_event: &mut impl FnMut(MonitorEvent),
     ) {
         if first_sample != self.next_sample {
+            // A selection under way is used before the jump (a restart may go back).
+            if self.band_result_at.is_some() {
+                self.use_band_result(on_event);
+            }
             if first_sample > self.next_sample {
                 on_event(MonitorEvent::Gap {
                     at_sample: self.next_sample,
@@ -397,6 +432,9 @@ impl ChannelMonitor {
     /// sample whatever the block sizes.
     fn push_samples(&mut self, mut samples: &[f32], on_event: &mut impl FnMut(MonitorEvent)) {
         while !samples.is_empty() {
+            if self.band_result_at.is_some_and(|at| at <= self.next_sample) {
+                self.use_band_result(on_event);
+            }
             if let Some((at, hz)) = self.pending_speed {
                 if at <= self.next_sample {
                     self.pending_speed = None;
@@ -412,11 +450,14 @@ impl ChannelMonitor {
             if let Some((at, _)) = self.pending_speed {
                 take = take.min((at - self.next_sample) as usize);
             }
+            if let Some(at) = self.band_result_at {
+                take = take.min((at - self.next_sample) as usize);
+            }
             self.analyse(&samples[..take], on_event);
             samples = &samples[take..];
             if self.next_sample >= self.next_band_selection {
                 if self.history_filled == self.history.len() {
-                    self.select_bands(on_event);
+                    self.start_band_selection(on_event);
                 }
                 let phase = if self.history_filled == self.history.len() {
                     std::mem::take(&mut self.band_phase_left)
@@ -537,52 +578,52 @@ impl ChannelMonitor {
         (f64::from(self.history[index]) * self.history_scale) as f32
     }
 
-    /// Runs the whole-record analysis over the history and follows its bands.
-    fn select_bands(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
-        let n = self.history.len();
+    /// Starts a band selection over the history (unless one is under way, or nothing could
+    /// be scored: no speed and no estimate); with no delay its result is used at once.
+    fn start_band_selection(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
         let estimating = matches!(self.settings.speed, SpeedMode::Estimate(_));
-        if !self.speed_known && !estimating {
+        if self.band_result_at.is_some() || (!self.speed_known && !estimating) {
             return;
         }
-        let contiguous: Vec<f32> = (0..n)
-            .map(|i| self.history_sample((self.history_at + i) % n))
-            .collect();
-        if let SpeedMode::Estimate(search) = self.settings.speed {
-            // A failed estimate keeps the last one; without any, nothing is scored yet. (The
-            // plans' lock is not held while events go out.)
-            let estimate = estimate_shaft_hz(
-                &mut FftPlans::shared(),
-                &contiguous,
-                self.settings.fs_hz,
-                search,
-            );
-            if let Some(estimate) = estimate {
-                self.apply_speed(Some(estimate.shaft_hz), true, on_event);
-            }
-            if !self.speed_known {
-                return;
-            }
+        let n = self.history.len();
+        let (newer, older) = self.history.split_at(self.history_at);
+        let mut counts = Vec::with_capacity(n);
+        counts.extend_from_slice(older);
+        counts.extend_from_slice(newer);
+        self.band_selector.start(std::sync::Arc::new(BandJob {
+            counts,
+            scale: self.history_scale,
+            fs_hz: self.settings.fs_hz,
+            freqs: self.freqs,
+            orders: self.orders,
+            speed_known: self.speed_known,
+            max_shaft_hz: self.settings.speed.max_shaft_hz(self.freqs.shaft),
+            speed: self.settings.speed,
+            analysis: self.settings.analysis.clone(),
+        }));
+        self.band_result_at = Some(self.next_sample + self.band_delay_samples);
+        if self.band_delay_samples == 0 {
+            self.use_band_result(on_event);
         }
-        let analysis = analyze_with_plans(
-            &mut FftPlans::shared(),
-            &contiguous,
-            self.settings.fs_hz,
-            &self.freqs,
-            &self.settings.analysis,
-        );
-        let Ok(analysis) = analysis else {
+    }
+
+    /// Takes the result of the selection under way (waiting for it if it is not done) and
+    /// follows its speed estimate and its bands.
+    fn use_band_result(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
+        self.band_result_at = None;
+        let Some(BandResult {
+            estimated_shaft_hz,
+            bands,
+        }) = self.band_selector.finish()
+        else {
             return;
         };
-        let band_of = |kind: FaultKind| {
-            analysis
-                .hypotheses
-                .iter()
-                .find(|h| h.score.fault == kind)
-                .map_or(analysis.selected_band(), |h| {
-                    analysis.scan.bands[h.band_index].band
-                })
+        if let Some(hz) = estimated_shaft_hz {
+            self.apply_speed(Some(hz), true, on_event);
+        }
+        let Some((bands, selected)) = bands.filter(|_| self.speed_known) else {
+            return;
         };
-        let bands = FaultKind::ALL.map(band_of);
         if !self.bands_known || bands != self.bands {
             self.rolling.set_bands(&bands);
             self.bands = bands;
@@ -591,7 +632,7 @@ impl ChannelMonitor {
         on_event(MonitorEvent::Bands {
             at_sample: self.next_sample,
             bands,
-            selected: analysis.selected_band(),
+            selected,
         });
     }
 
@@ -642,18 +683,5 @@ impl ChannelMonitor {
                 });
             }
         }
-    }
-}
-
-/// `freqs` with every frequency multiplied by `factor` (they are all proportional to the shaft
-/// rate, MODELS.md §1).
-fn scaled(freqs: &FaultFrequencies, factor: f64) -> FaultFrequencies {
-    FaultFrequencies {
-        shaft: freqs.shaft * factor,
-        ftf: freqs.ftf * factor,
-        bpfo: freqs.bpfo * factor,
-        bpfi: freqs.bpfi * factor,
-        bsf: freqs.bsf * factor,
-        two_bsf: freqs.two_bsf * factor,
     }
 }

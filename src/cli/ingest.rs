@@ -128,6 +128,7 @@ async fn ingest(args: &IngestArgs) -> Result<Report, CliError> {
     let idle = args.until_idle.map(|s| Duration::from_secs_f64(s.max(0.0)));
     let mut first_event: Option<Instant> = None;
     let mut last_event = started;
+    let mut last_block = started;
     let mut stop_tx = Some(stop_tx);
     // Where each stream's next block must start unless a gap or restart is announced.
     let mut expected_next: BTreeMap<(u8, u8), u64> = BTreeMap::new();
@@ -144,6 +145,9 @@ async fn ingest(args: &IngestArgs) -> Result<Report, CliError> {
                 last_event = now;
                 match event {
                     IngestEvent::Samples(block) => {
+                        // "While data arrived": from the first event to the last sample block
+                        // (a sensor-lost report comes a timeout after the data).
+                        last_block = now;
                         let key = (block.node, block.axis);
                         if let Some(&next) = expected_next.get(&key) {
                             if next != block.first_sample {
@@ -180,7 +184,7 @@ async fn ingest(args: &IngestArgs) -> Result<Report, CliError> {
         .await
         .map_err(|e| CliError::failure(format!("source task: {e}")))??;
     let busy = match first_event {
-        Some(first) => (last_event - first).as_secs_f64(),
+        Some(first) => last_block.saturating_duration_since(first).as_secs_f64(),
         None => 0.0,
     };
     let failures = check_expectations(args, &summary, discontinuities);

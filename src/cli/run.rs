@@ -97,7 +97,7 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
             .map_err(CliError::input)
     })?;
     println!(
-        "summary: {} messages, {} twin fits ({} skipped while busy), {} alerts published{}",
+        "summary: {} messages, {} twin fits ({} dropped), {} alerts published{}",
         summary.messages,
         summary.twin_fits,
         summary.twin_requests_skipped,
@@ -204,6 +204,14 @@ fn event_line(event: &DaemonEvent) -> String {
         DaemonEvent::AlertDropped(dropped) => format!("bearingd: {dropped}"),
         #[cfg(feature = "shm")]
         DaemonEvent::AlertFailed(error) => format!("bearingd: {error}"),
+        DaemonEvent::TwinFitDropped {
+            channel,
+            dropped_end_sample,
+            total,
+        } => format!(
+            "bearingd: twin re-fit of {channel} at sample {dropped_end_sample} dropped: the \
+             re-fit thread is behind and the channel asked again ({total} dropped so far)"
+        ),
         DaemonEvent::SourceStopped { source, error } => {
             format!("bearingd: {source} stopped: {error}")
         }
@@ -295,7 +303,7 @@ pub fn status_line(s: &ChannelStatus) -> String {
         (None, _) => "?(no usable speed frame: scoring waits)".to_string(),
     };
     format!(
-        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} flags={}{}",
+        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} flags={}{}{}",
         s.channel,
         s.seconds,
         rpm,
@@ -304,6 +312,11 @@ pub fn status_line(s: &ChannelStatus) -> String {
         twin,
         s.stage,
         s.flags_summary(),
+        if s.gaps > 0 {
+            format!(" GAPS {} ({} samples missing)", s.gaps, s.missing_samples)
+        } else {
+            String::new()
+        },
         if s.sensor_lost { " SENSOR LOST" } else { "" }
     )
 }

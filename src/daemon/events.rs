@@ -44,6 +44,13 @@ pub enum DaemonEvent {
     /// The publisher thread could not publish an alert.
     #[cfg(feature = "shm")]
     AlertFailed(AlertError),
+    /// A twin re-fit request of `channel` (its window ending at `dropped_end_sample`) was
+    /// still waiting when the channel asked again: that fit is not made. `total` so far.
+    TwinFitDropped {
+        channel: ChannelId,
+        dropped_end_sample: u64,
+        total: u64,
+    },
     /// A live source stopped with an error (`source` names it: `CAN source`, `iceoryx2 source
     /// bearingd/accel/<sensor>`).
     SourceStopped { source: String, error: String },

@@ -12,8 +12,9 @@
 //! - analysis thread ([`AnalysisThread`]): owns the [`Pipeline`] and the alert sink; hands
 //!   messages to the sink queue (`Block`), flag changes straight to the alert publisher
 //!   (`DropNewest`, counted and reported; alerts are rare), and twin requests to the re-fit
-//!   queue (capacity 1, `DropNewest`: a request that finds the re-fit thread busy is skipped and
-//!   counted; the next period brings a fresh one). Each input carries the wall-clock time its
+//!   hand-over ([`crate::pipeline::twin_queue`]: one slot per channel, served in turn; a request
+//!   still waiting when its channel asks again is dropped, counted and reported). Band
+//!   selections run on the pipeline's own worker thread ([`crate::pipeline::bands`]). Each input carries the wall-clock time its
 //!   source completed it ([`Arrived`]); alerts carry that time of the block that decided them,
 //!   so their latency includes any wait in the queue. The analysis never sees it. After every
 //!   input it publishes the channels' status on a `watch` channel (the latest value only).
@@ -36,7 +37,8 @@ use super::state::{load_baselines, save_baselines};
 use crate::config::{Config, Transport};
 use crate::mcap_log::McapLogError;
 use crate::messages::{FlagMessage, PipelineMessage, TwinMessage};
-use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinRequest, TwinWorker};
+use crate::pipeline::twin_queue::{twin_requests, TwinRequestQueue, TwinRequests};
+use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinWorker};
 use crate::sinks::alerts::PublisherSummary;
 use crate::sinks::mcap::McapSink;
 use crate::sinks::systemd::{keep_alive, status_text, Notifier};
@@ -130,7 +132,7 @@ pub async fn run(
 
     let (input_tx, input_rx) = async_mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
     let (sink_tx, sink_rx) = mpsc::sync_channel::<PipelineMessage>(SINK_QUEUE);
-    let (request_tx, request_rx) = mpsc::sync_channel::<TwinRequest>(1);
+    let (request_tx, request_rx) = twin_requests();
     let (fit_tx, fit_rx) = mpsc::sync_channel::<TwinMessage>(config.channel_count() + 1);
     let (status_tx, status_rx) = watch::channel(pipeline.status());
 
@@ -331,7 +333,7 @@ struct AnalysisThread {
     inputs: async_mpsc::Receiver<Arrived>,
     sinks: mpsc::SyncSender<PipelineMessage>,
     /// `None` once the inputs have ended (closing the re-fit queue).
-    twin_requests: Option<mpsc::SyncSender<TwinRequest>>,
+    twin_requests: Option<TwinRequests>,
     fits: mpsc::Receiver<TwinMessage>,
     status: watch::Sender<Vec<ChannelStatus>>,
     requests_skipped: u64,
@@ -390,11 +392,18 @@ impl AnalysisThread {
                 let _ = sinks.send(message);
             }
             Output::Twin(request) => {
-                let sent = twin_requests
-                    .as_ref()
-                    .is_some_and(|queue| queue.try_send(request).is_ok());
-                if !sent {
+                let (channel, end_sample) = (request.channel.clone(), request.end_sample);
+                let dropped = match twin_requests.as_ref() {
+                    Some(queue) => queue.put(request).map(|old| old.end_sample),
+                    None => Some(end_sample),
+                };
+                if let Some(dropped_end_sample) = dropped {
                     *requests_skipped += 1;
+                    events(DaemonEvent::TwinFitDropped {
+                        channel,
+                        dropped_end_sample,
+                        total: *requests_skipped,
+                    });
                 }
             }
         });
@@ -435,13 +444,10 @@ impl AnalysisThread {
 
 /// The re-fit thread: one request at a time, each fit handed back to the analysis thread.
 /// Returns the number of fits made.
-fn refit_thread(
-    requests: &mpsc::Receiver<TwinRequest>,
-    fits: &mpsc::SyncSender<TwinMessage>,
-) -> u64 {
+fn refit_thread(requests: &TwinRequestQueue, fits: &mpsc::SyncSender<TwinMessage>) -> u64 {
     let mut worker = TwinWorker::default();
     let mut made = 0u64;
-    while let Ok(request) = requests.recv() {
+    while let Some(request) = requests.take() {
         if let Some(fit) = worker.refit(&request) {
             made += 1;
             if fits.send(fit).is_err() {
@@ -547,8 +553,10 @@ fn start_live_sources(
                 sensor: sensor.clone(),
                 iox: crate::iox::IoxSettings::with_root(&config.outputs.iceoryx2_root),
                 silence_timeout: SENSOR_TIMEOUT,
+                // Back-pressure: the publisher's own strategy decides what a slow daemon
+                // costs (a waiting publisher loses nothing; a discarding one, exact gaps).
                 handoff_capacity: 64,
-                when_full: WhenFull::DropOldest,
+                when_full: WhenFull::Block,
                 stats_interval: Some(status_interval),
             };
             let (events_tx, events_rx) = async_mpsc::channel(ANALYSIS_QUEUE);

@@ -6,11 +6,17 @@
 //! `replay` alike, and its outputs depend only on its inputs, so a replay of the logged raw
 //! samples gives the same flags at the same samples.
 //!
+//! One exception to "single-threaded": band selections run on the [`bands`] worker thread,
+//! their results used a fixed sample-time delay ([`band_delay_s`]) after they started, so the
+//! outputs still depend only on the inputs.
+//!
 //! [`Sink`] is the seam to the sinks: the pipeline's messages go to whatever implements it
 //! (the MCAP log, the command line's flag printer), and the pipeline knows none of them.
 
+pub mod bands;
 pub mod refit;
 mod sink;
+pub mod twin_queue;
 
 pub use refit::TwinWorker;
 pub use sink::{Sink, SinkError};
@@ -201,6 +207,20 @@ pub fn band_history_s(config: &Config) -> f64 {
 
 const MAX_BAND_HISTORY_S: f64 = 10.0;
 
+/// Seconds of sample time from a band selection's start (on the worker thread) to the sample
+/// where its bands are used: 2 s, or half the band period if that is shorter. Long enough for
+/// the worker to finish the selections of many channels (30–100 ms each) before the analysis
+/// needs them; short against the band period (default 20 s) and the flags' delays.
+pub fn band_delay_s(config: &Config) -> f64 {
+    (config.band_period_s / 2.0).min(MAX_BAND_DELAY_S)
+}
+
+const MAX_BAND_DELAY_S: f64 = 2.0;
+
+/// Seconds of sample time between the first band selections of two channels (a selection
+/// takes 30–100 ms; each holds a copy of its channel's history until it is done).
+const FIRST_SELECTION_SPACING_S: f64 = 0.25;
+
 impl Channel {
     /// A speed given from outside, at `at_sample` of this channel.
     fn speed_at(
@@ -231,6 +251,7 @@ impl Pipeline {
         let mut channels = BTreeMap::new();
         let turns: usize = config.sensors.iter().map(|s| s.axes.len()).sum();
         let mut turn = 0;
+        let worker = bands::BandWorker::start(turns);
         for sensor in &config.sensors {
             // Without a starting speed the channel waits (nothing is scored); its frequencies
             // are then those at the highest speed, for sizing only.
@@ -244,11 +265,24 @@ impl Pipeline {
                     sensor: sensor.id.clone(),
                     axis: axis.clone(),
                 };
-                let monitor = ChannelMonitor::new(
+                let mut monitor = ChannelMonitor::new(
                     monitor_settings(config, sensor, turn, turns),
                     freqs,
                     baselines.get(&id).cloned(),
                 );
+                if let Some(worker) = &worker {
+                    // The channels' first selections (all due when their histories fill) take
+                    // turns, FIRST_SELECTION_SPACING_S apart (within one band period), so that
+                    // the worker is not handed every channel's history at once.
+                    let fs = sensor.sample_rate_hz;
+                    let spacing_s =
+                        FIRST_SELECTION_SPACING_S.min(config.band_period_s / turns.max(1) as f64);
+                    monitor = monitor.with_band_selector(
+                        Box::new(worker.selector()),
+                        (band_delay_s(config) * fs).round() as u64,
+                        (spacing_s * turn as f64 * fs).round() as u64,
+                    );
+                }
                 turn += 1;
                 let status = ChannelStatus {
                     channel: id.clone(),

@@ -105,6 +105,16 @@ impl<T> Producer<T> {
     }
 }
 
+impl<T> Producer<T> {
+    /// Whether a push now would find the queue full.
+    pub fn is_full(&self) -> bool {
+        self.shared
+            .state
+            .lock()
+            .map_or(true, |state| state.items.len() >= self.shared.capacity)
+    }
+}
+
 impl<T> Drop for Producer<T> {
     fn drop(&mut self) {
         if let Ok(mut state) = self.shared.state.lock() {

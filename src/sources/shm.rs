@@ -1,11 +1,21 @@
 //! iceoryx2 source: [`FrameBatch`]es from the publish-subscribe service
-//! `bearingd/accel/<sensor>`, on a thread of its own.
+//! `bearingd/accel/<sensor>`, decoded on a thread of its own straight out of shared memory.
 //!
 //! Why a thread: iceoryx2 ports are not `Send` and have no async API, so they must not live on
 //! a tokio worker. The thread waits on the event service `bearingd/accel/<sensor>/wake` (the
 //! publisher notifies after sending; a timed wait also polls, so a lost wake-up costs at most
-//! [`POLL_PERIOD`]), drains the subscriber and hands the batches to the async side through a
-//! bounded [`handoff`](super::handoff) queue, where the shared assembler decodes them.
+//! [`POLL_PERIOD`]), and feeds every received sample's frames to the [`Assembler`] while the
+//! sample is still loaned from shared memory: no copy of a batch is ever made (the publisher
+//! wrote it in place too). Only the assembler's events (sample blocks, gaps, …) cross to the
+//! async side, through a bounded [`handoff`](super::handoff) queue. The silence watch runs on
+//! the thread as well; the async side only asks for the counters at the stats interval.
+//!
+//! Back-pressure ([`ShmSourceConfig::when_full`]): with `Block` a full hand-off makes the
+//! thread stop taking samples, the subscriber's iceoryx2 buffer fills, and the publisher then
+//! decides by its own strategy: wait (lossless; `firmware-sim` by default) or discard (a live
+//! node; the receiver's sequence tracker reports the exact gap). With `DropOldest` the thread
+//! keeps taking samples while the hand-off is full and drops them undecoded, counted as
+//! `handoff_dropped` and seen as exact gaps. Nothing is ever dropped after the assembler.
 //!
 //! Ready handshake: a subscriber connects to a publisher only inside `receive()`; samples sent
 //! before that can be lost. So, while it has received nothing, the thread notifies the event
@@ -21,8 +31,7 @@ use super::{
     node_of, Assembler, EventSender, IngestEvent, SilenceWatch, SourceSummary, StatsTimer,
 };
 use crate::iox::{
-    create_node, open_data_service, open_event_service, FrameBatch, IoxSettings, ServiceNames,
-    ShmError,
+    create_node, open_data_service, open_event_service, IoxSettings, ServiceNames, ShmError,
 };
 use iceoryx2::prelude::*;
 use std::future::Future;
@@ -40,12 +49,20 @@ pub struct ShmSourceConfig {
     pub sensor: String,
     pub iox: IoxSettings,
     pub silence_timeout: Duration,
-    /// Batches between the port thread and the async side.
+    /// Events (sample blocks and the like) between the port thread and the async side.
     pub handoff_capacity: usize,
-    /// `DropOldest` for live sensors; `Block` to push back into iceoryx2 instead.
+    /// `Block`: back-pressure into iceoryx2 (the daemon); `DropOldest`: drop the batches
+    /// waiting in iceoryx2 undecoded while the hand-off is full (see the module docs).
     pub when_full: WhenFull,
     /// Report the counters ([`IngestEvent::Stats`]) this often and when stopping; `None`: never.
     pub stats_interval: Option<Duration>,
+}
+
+/// Flags between the async side and the port thread.
+#[derive(Default)]
+struct Control {
+    stop: AtomicBool,
+    stats_wanted: AtomicBool,
 }
 
 /// Starts the port thread, waits until its ports exist, then runs until `shutdown`, the
@@ -55,79 +72,69 @@ pub async fn run(
     events: EventSender,
     shutdown: impl Future<Output = ()>,
 ) -> Result<SourceSummary, ShmError> {
+    // The queue itself always waits: after the assembler nothing may be dropped.
     let (producer, consumer) =
-        handoff::bounded::<Box<FrameBatch>>(config.handoff_capacity, config.when_full);
-    let stop = Arc::new(AtomicBool::new(false));
+        handoff::bounded::<IngestEvent>(config.handoff_capacity, WhenFull::Block);
+    let control = Arc::new(Control::default());
     let (started_tx, started_rx) = tokio::sync::oneshot::channel::<Result<(), ShmError>>();
     let thread = {
-        let stop = stop.clone();
+        let control = control.clone();
         let config = config.clone();
         std::thread::Builder::new()
             .name(format!("iox2-{}", config.sensor))
-            .spawn(move || port_thread(&config, producer, &stop, started_tx))
+            .spawn(move || port_thread(&config, producer, &control, started_tx))
             .map_err(|e| ShmError::Thread(e.to_string()))?
     };
-    let stop_thread = || {
-        stop.store(true, Ordering::Relaxed);
+    let join = |thread: std::thread::JoinHandle<SourceSummary>| async move {
+        tokio::task::spawn_blocking(move || thread.join())
+            .await
+            .map_err(|e| ShmError::Thread(e.to_string()))?
+            .map_err(|_| ShmError::Thread("the port thread panicked".into()))
     };
     match started_rx.await {
         Ok(Ok(())) => {}
         Ok(Err(e)) => {
-            let _ = thread.join();
+            let _ = join(thread).await;
             return Err(e);
         }
         Err(_) => {
-            let _ = thread.join();
+            let _ = join(thread).await;
             return Err(ShmError::Thread("port thread ended before starting".into()));
         }
     }
-    let mut assembler = Assembler::new();
-    let mut watch = SilenceWatch::new(config.silence_timeout);
-    let mut out: Vec<IngestEvent> = Vec::with_capacity(64);
-    let mut tick = tokio::time::interval((watch.timeout() / 4).max(Duration::from_millis(10)));
-    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
     let mut stats = StatsTimer::new(config.stats_interval);
+    let mut consumer_gone = false;
     tokio::pin!(shutdown);
     loop {
         tokio::select! {
             biased;
             () = &mut shutdown => break,
             item = consumer.pop() => {
-                let Some((batch, dropped)) = item else { break };
-                assembler.count_handoff_drop(dropped);
-                let now = Instant::now();
-                match batch.valid_frames() {
-                    Ok(frames) => {
-                        for frame in frames {
-                            if let Some(node) = node_of(frame.can_id) {
-                                watch.heard(node, now);
-                            }
-                            assembler.push(frame.can_id, frame.bytes(), &mut out);
-                        }
-                    }
-                    Err(e) => assembler.refuse_batch(format!("service bearingd/accel/{}: {e}", config.sensor), &mut out),
+                let Some((event, _)) = item else { break };
+                if events.send(event).await.is_err() {
+                    consumer_gone = true;
+                    break;
                 }
             }
-            _ = tick.tick() => watch.check(Instant::now(), &mut assembler, &mut out),
-            () = stats.tick() => out.push(IngestEvent::Stats(assembler.stats())),
+            () = stats.tick() => control.stats_wanted.store(true, Ordering::Relaxed),
         }
-        for event in out.drain(..) {
+    }
+    control.stop.store(true, Ordering::Relaxed);
+    // What the thread has decoded still goes out (it stops within a poll period).
+    if !consumer_gone {
+        while let Some((event, _)) = consumer.pop().await {
             if events.send(event).await.is_err() {
-                stop_thread();
-                drop(consumer);
-                let _ = thread.join();
-                return Ok(summary(&assembler));
+                break;
             }
         }
     }
-    stop_thread();
     drop(consumer);
-    let _ = tokio::task::spawn_blocking(move || thread.join()).await;
-    if stats.enabled() {
-        // The final counters; a consumer already gone needs none.
-        let _ = events.send(IngestEvent::Stats(assembler.stats())).await;
+    let summary = join(thread).await?;
+    if stats.enabled() && !consumer_gone {
+        // The final counters.
+        let _ = events.send(IngestEvent::Stats(summary.stats)).await;
     }
-    Ok(summary(&assembler))
+    Ok(summary)
 }
 
 fn summary(assembler: &Assembler) -> SourceSummary {
@@ -137,12 +144,13 @@ fn summary(assembler: &Assembler) -> SourceSummary {
     }
 }
 
+/// The port thread: receives, decodes in place, hands the events over; returns the counters.
 fn port_thread(
     config: &ShmSourceConfig,
-    producer: handoff::Producer<Box<FrameBatch>>,
-    stop: &AtomicBool,
+    producer: handoff::Producer<IngestEvent>,
+    control: &Control,
     started: tokio::sync::oneshot::Sender<Result<(), ShmError>>,
-) {
+) -> SourceSummary {
     let names = ServiceNames::for_sensor(&config.sensor);
     let setup = (|| {
         let node = create_node(&config.iox)?;
@@ -177,28 +185,58 @@ fn port_thread(
         }
         Err(e) => {
             let _ = started.send(Err(e));
-            return;
+            return summary(&Assembler::new());
         }
     };
+    let mut assembler = Assembler::new();
+    let mut watch = SilenceWatch::new(config.silence_timeout);
+    let mut out: Vec<IngestEvent> = Vec::with_capacity(64);
+    let service = format!("service {}", names.data);
     let mut received_any = false;
-    while !stop.load(Ordering::Relaxed) {
+    let stopped = || control.stop.load(Ordering::Relaxed);
+    // Hands the events over, waiting for room; `false` once the async side is gone.
+    let hand_over = |out: &mut Vec<IngestEvent>| out.drain(..).all(|event| producer.push(event));
+    while !stopped() {
         // Woken by the publisher, or after POLL_PERIOD at the latest; the wake-ups themselves
         // carry nothing.
         let _ = wake.timed_wait(|_| {}, POLL_PERIOD);
-        loop {
-            match subscriber.receive() {
-                Ok(Some(sample)) => {
-                    received_any = true;
-                    if !producer.push(Box::new(*sample.payload())) {
-                        return;
+        while !stopped() {
+            let Ok(Some(sample)) = subscriber.receive() else {
+                break;
+            };
+            received_any = true;
+            if config.when_full == WhenFull::DropOldest && producer.is_full() {
+                assembler.count_handoff_drop(1);
+                continue;
+            }
+            let now = Instant::now();
+            // Decoded in place: the frames are read from the loaned shared-memory sample.
+            match sample.payload().valid_frames() {
+                Ok(frames) => {
+                    for frame in frames {
+                        if let Some(node) = node_of(frame.can_id) {
+                            watch.heard(node, now);
+                        }
+                        assembler.push(frame.can_id, frame.bytes(), &mut out);
                     }
                 }
-                Ok(None) => break,
-                Err(_) => break,
+                Err(e) => assembler.refuse_batch(format!("{service}: {e}"), &mut out),
             }
+            drop(sample);
+            if !hand_over(&mut out) {
+                return summary(&assembler);
+            }
+        }
+        watch.check(Instant::now(), &mut assembler, &mut out);
+        if control.stats_wanted.swap(false, Ordering::Relaxed) {
+            out.push(IngestEvent::Stats(assembler.stats()));
+        }
+        if !hand_over(&mut out) {
+            break;
         }
         if !received_any && data.dynamic_config().number_of_publishers() > 0 {
             let _ = ready.notify();
         }
     }
+    summary(&assembler)
 }

@@ -115,6 +115,11 @@ struct Args {
     /// Sample time runs this many times faster than real time; 0 = as fast as the bus allows.
     #[arg(long, default_value_t = 1.0)]
     speed_factor: f64,
+    /// Simulate only the first S seconds of each stream and send them over and over (a
+    /// throughput bench: the twin's simulation, not the transport, would otherwise be the
+    /// limit). 0 = simulate everything.
+    #[arg(long, value_name = "S", default_value_t = 0.0)]
+    loop_after: f64,
     /// Send a recording (CWRU .mat, CSV, …) instead of the twin.
     #[arg(long)]
     recording: Option<PathBuf>,
@@ -149,7 +154,12 @@ struct Args {
 /// Where samples come from.
 enum Signal {
     Twin(Vec<Simulator>),
-    Recording { samples: Vec<f64>, next: usize },
+    /// Each stream's first samples, repeated (`--loop-after`).
+    Looped(Vec<Vec<f32>>),
+    Recording {
+        samples: Vec<f64>,
+        next: usize,
+    },
 }
 
 #[derive(Debug, Default)]
@@ -220,7 +230,7 @@ fn run(args: &Args) -> Result<(), SimError> {
     let total = (args.duration * f64::from(fs)).round() as u64;
     let total = match &signal {
         Signal::Recording { samples, .. } => total.min(samples.len() as u64),
-        Signal::Twin(_) => total,
+        Signal::Twin(_) | Signal::Looped(_) => total,
     };
     let chunk = u64::from((fs / 100).max(28));
     let mut pacer = BusPacer::new(
@@ -396,7 +406,7 @@ fn open_signal(args: &Args) -> Result<(Signal, u32, f64), SimError> {
     };
     let rpm = args.rpm.unwrap_or(DEFAULT_RPM);
     let streams = usize::from(args.nodes) * usize::from(args.axes);
-    let simulators = (0..streams)
+    let simulators: Vec<Simulator> = (0..streams)
         .map(|i| {
             let mut params = SimulationParams::example(fault);
             params.rpm = rpm;
@@ -407,6 +417,20 @@ fn open_signal(args: &Args) -> Result<(Signal, u32, f64), SimError> {
             Simulator::new(params)
         })
         .collect();
+    let loop_len = (args.loop_after.max(0.0) * f64::from(fs)).round() as usize;
+    if loop_len > 0 {
+        let looped = simulators
+            .into_iter()
+            .map(|mut sim| {
+                let mut samples = vec![0f32; loop_len];
+                for chunk in samples.chunks_mut((fs / 100).max(28) as usize) {
+                    sim.fill(chunk);
+                }
+                samples
+            })
+            .collect();
+        return Ok((Signal::Looped(looped), fs, rpm));
+    }
     Ok((Signal::Twin(simulators), fs, rpm))
 }
 
@@ -416,6 +440,13 @@ fn fill(signal: &mut Signal, source: usize, out: &mut [f32], at: u64) {
         Signal::Twin(simulators) => {
             if let Some(sim) = simulators.get_mut(source) {
                 sim.fill(out);
+            }
+        }
+        Signal::Looped(streams) => {
+            if let Some(samples) = streams.get(source).filter(|s| !s.is_empty()) {
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = samples[(at as usize + i) % samples.len()];
+                }
             }
         }
         Signal::Recording { samples, next } => {

@@ -120,13 +120,17 @@ pub mod shm {
         ServiceNames, ShmError, WireFrame,
     };
     use iceoryx2::prelude::*;
+    use iceoryx2::sample_mut::SampleMut;
     use std::time::{Duration, Instant};
 
     /// Publishes frames in batches of up to 64 on `bearingd/accel/<sensor>` and notifies
-    /// `.../wake` after each batch.
+    /// `.../wake` after each batch. Zero-copy: the batch is a sample loaned from the shared
+    /// memory (`loan_uninit` + `write_payload` of an empty header), the frames are written into
+    /// it in place, and sending only hands its offset to the subscribers.
     pub struct ShmTransport {
         service: String,
-        batch: FrameBatch,
+        /// The batch being filled, in shared memory.
+        loaned: Option<SampleMut<ipc::Service, FrameBatch, ()>>,
         publisher: iceoryx2::port::publisher::Publisher<ipc::Service, FrameBatch, ()>,
         wake: iceoryx2::port::notifier::Notifier<ipc::Service>,
         ready: iceoryx2::port::listener::Listener<ipc::Service>,
@@ -162,7 +166,7 @@ pub mod shm {
                 .map_err(|e| SimError::Shm(format!("{}: create listener: {e:?}", names.ready)))?;
             Ok(ShmTransport {
                 service: names.data,
-                batch: FrameBatch::default(),
+                loaned: None,
                 publisher,
                 wake,
                 ready,
@@ -199,22 +203,38 @@ pub mod shm {
                 can_id: u32::from(can_id),
                 detail: format!("{} bytes do not fit a wire frame", bytes.len()),
             })?;
-            if self.batch.is_full() {
+            if self
+                .loaned
+                .as_ref()
+                .is_some_and(|sample| sample.payload().is_full())
+            {
                 self.flush()?;
             }
-            self.batch.push(frame);
+            let sample = match self.loaned.as_mut() {
+                Some(sample) => sample,
+                None => {
+                    let sample = self
+                        .publisher
+                        .loan_uninit()
+                        .map_err(|e| SimError::Shm(format!("{}: loan: {e:?}", self.service)))?
+                        .write_payload(FrameBatch::default());
+                    self.loaned.insert(sample)
+                }
+            };
+            sample.payload_mut().push(frame);
             Ok(())
         }
 
         fn flush(&mut self) -> Result<(), SimError> {
-            if self.batch.count == 0 {
+            let Some(sample) = self.loaned.take() else {
                 return Ok(());
-            }
-            self.publisher
-                .send_copy(self.batch)
+            };
+            // With a waiting publisher (the default) this waits for room in the subscriber's
+            // buffer: back-pressure, nothing lost.
+            sample
+                .send()
                 .map_err(|e| SimError::Shm(format!("{}: send: {e:?}", self.service)))?;
             self.batches_sent += 1;
-            self.batch.clear();
             let _ = self.wake.notify();
             Ok(())
         }

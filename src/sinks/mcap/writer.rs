@@ -214,6 +214,10 @@ impl OpenFile {
             .library(concat!("bearingd ", env!("CARGO_PKG_VERSION")))
             .compression(Some(Compression::Zstd))
             .compression_level(config.zstd_level)
+            // Single-threaded zstd on the sink thread: the crate's default (one worker per
+            // physical CPU) allocated about 50 MB of compression context for a few hundred
+            // kB/s of log and competed with the analysis thread for the cores (issue 12).
+            .compression_threads(0)
             .chunk_size(Some(config.chunk_size))
             .create(stream)
             .map_err(werr)?;

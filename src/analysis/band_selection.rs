@@ -1,0 +1,143 @@
+//! A channel's band selection as a job: cut from the history at the sample it is due, computed
+//! anywhere, used at a sample fixed in advance.
+//!
+//! Why: a band selection (the whole-record analysis of the last 10 s, plus the speed estimate)
+//! costs 30–100 ms per 25.6 kHz channel. Run inline it holds the analysis thread, and every block
+//! that arrives meanwhile (and any alert it decides) waits. As a job it can run on another thread
+//! ([`BandSelector`]) while the monitor goes on; the monitor uses the result at `due` = start +
+//! a delay in samples, and waits for it there if it is late. So the result takes effect at the
+//! same sample whatever thread ran it and however long it took: a replay repeats every event.
+
+use super::envelope::FftPlans;
+use super::monitor::SpeedMode;
+use super::record::analyze_with_plans;
+use super::speed::estimate_shaft_hz;
+use super::{AnalysisSettings, Band};
+use crate::bearing::FaultFrequencies;
+use crate::messages::FaultKind;
+use std::collections::VecDeque;
+use std::sync::Arc;
+
+/// What a band selection needs, copied out of the monitor when it is due.
+#[derive(Debug, Clone)]
+pub struct BandJob {
+    /// The history, oldest first, as the sensor's counts.
+    pub counts: Vec<i16>,
+    /// g per count.
+    pub scale: f64,
+    pub fs_hz: f64,
+    /// The fault frequencies the channel scores with now.
+    pub freqs: FaultFrequencies,
+    /// Fault frequencies per Hz of shaft rate (to scale to an estimated speed).
+    pub orders: FaultFrequencies,
+    /// Whether `freqs` may be used (the speed is known).
+    pub speed_known: bool,
+    /// The highest usable shaft rate, Hz.
+    pub max_shaft_hz: f64,
+    pub speed: SpeedMode,
+    pub analysis: AnalysisSettings,
+}
+
+/// What a band selection found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BandResult {
+    /// The speed estimate, Hz, when the channel estimates its speed and one was found.
+    pub estimated_shaft_hz: Option<f64>,
+    /// One band per fault kind ([`FaultKind::ALL`] order) and the method's choice; `None` when
+    /// no speed was usable or the analysis failed (the bands stay as they are).
+    pub bands: Option<([Band; 4], Band)>,
+}
+
+/// A shaft rate given or estimated, if usable: finite, positive, at most `max_shaft_hz`.
+pub fn usable_shaft_hz(given: Option<f64>, max_shaft_hz: f64) -> Option<f64> {
+    given.filter(|&hz| hz.is_finite() && hz > 0.0 && hz <= max_shaft_hz * (1.0 + 1e-9))
+}
+
+/// `freqs` with every frequency multiplied by `factor` (they are all proportional to the shaft
+/// rate, MODELS.md §1).
+pub fn scaled(freqs: &FaultFrequencies, factor: f64) -> FaultFrequencies {
+    FaultFrequencies {
+        shaft: freqs.shaft * factor,
+        ftf: freqs.ftf * factor,
+        bpfo: freqs.bpfo * factor,
+        bpfi: freqs.bpfi * factor,
+        bsf: freqs.bsf * factor,
+        two_bsf: freqs.two_bsf * factor,
+    }
+}
+
+impl BandJob {
+    /// Runs the selection: the speed estimate (when estimating), then the whole-record analysis
+    /// with the frequencies at the speed the monitor will have once it takes the result.
+    pub fn run(&self, plans: &mut FftPlans) -> BandResult {
+        let signal: Vec<f32> = self
+            .counts
+            .iter()
+            .map(|&c| (f64::from(c) * self.scale) as f32)
+            .collect();
+        let mut freqs = self.freqs;
+        let mut known = self.speed_known;
+        let mut estimated_shaft_hz = None;
+        if let SpeedMode::Estimate(search) = self.speed {
+            // A failed estimate keeps the last one; without any, nothing is scored yet.
+            if let Some(estimate) = estimate_shaft_hz(plans, &signal, self.fs_hz, search) {
+                estimated_shaft_hz = Some(estimate.shaft_hz);
+                let usable = usable_shaft_hz(Some(estimate.shaft_hz), self.max_shaft_hz);
+                if let Some(hz) = usable {
+                    freqs = scaled(&self.orders, hz);
+                }
+                known = usable.is_some();
+            }
+        }
+        if !known {
+            return BandResult {
+                estimated_shaft_hz,
+                bands: None,
+            };
+        }
+        let bands = analyze_with_plans(plans, &signal, self.fs_hz, &freqs, &self.analysis)
+            .ok()
+            .map(|analysis| {
+                let band_of = |kind: FaultKind| {
+                    analysis
+                        .hypotheses
+                        .iter()
+                        .find(|h| h.score.fault == kind)
+                        .map_or(analysis.selected_band(), |h| {
+                            analysis.scan.bands[h.band_index].band
+                        })
+                };
+                (FaultKind::ALL.map(band_of), analysis.selected_band())
+            });
+        BandResult {
+            estimated_shaft_hz,
+            bands,
+        }
+    }
+}
+
+/// Runs a monitor's band selections: [`start`](Self::start) hands over a job,
+/// [`finish`](Self::finish) returns the oldest unfinished job's result, waiting for it if
+/// needed. Jobs finish in the order they started.
+pub trait BandSelector: Send {
+    fn start(&mut self, job: Arc<BandJob>);
+    /// `None` only if no job was started.
+    fn finish(&mut self) -> Option<BandResult>;
+}
+
+/// Runs each job on the calling thread when it starts (`bearingd analyze`, tests, and a
+/// monitor whose results are used at once).
+#[derive(Default)]
+pub struct InlineSelector {
+    done: VecDeque<BandResult>,
+}
+
+impl BandSelector for InlineSelector {
+    fn start(&mut self, job: Arc<BandJob>) {
+        self.done.push_back(job.run(&mut FftPlans::shared()));
+    }
+
+    fn finish(&mut self) -> Option<BandResult> {
+        self.done.pop_front()
+    }
+}
