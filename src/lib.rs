@@ -18,6 +18,8 @@
 //! - [`twin`]: the signal-model twin of a defective bearing (simulation now, fitting later).
 //! - [`ingest`]: sources (SocketCAN, iceoryx2) that turn sensor frames into sample blocks in
 //!   sample time, counting gaps, restarts, silent sensors and malformed frames.
+//! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
+//!   SNR, speed and bearing through the real pipeline (`bearingd evaluate`).
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
@@ -28,6 +30,7 @@ pub mod bearing;
 pub mod cli;
 pub mod config;
 pub mod daemon;
+pub mod evaluate;
 pub mod ingest;
 pub mod mcap_log;
 pub mod offline;
