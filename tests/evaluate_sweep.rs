@@ -34,7 +34,8 @@ fn describe(r: &CaseResult) -> String {
         r.case.severity,
         r.case.noise.label(),
         r.noise_g,
-        r.snr_db.map_or(String::new(), |s| format!(", SNR {s:+.1} dB")),
+        r.snr_db
+            .map_or(String::new(), |s| format!(", SNR {s:+.1} dB")),
         flags.join(", ")
     )
 }
@@ -77,7 +78,11 @@ fn issue16_quick_sweep_flags_every_fault_and_no_healthy_bearing() {
         .iter()
         .filter(|r| r.case.fault == SimulatedFault::None)
         .collect();
-    assert!(healthy.len() >= 6, "too few healthy records: {}", healthy.len());
+    assert!(
+        healthy.len() >= 6,
+        "too few healthy records: {}",
+        healthy.len()
+    );
     for r in &healthy {
         for path in Path::BOTH {
             if path.predicted(r) != Predicted::None {

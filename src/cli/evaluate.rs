@@ -70,7 +70,9 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
         std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
     });
     if threads == 0 {
-        return Err(CliError::input("--jobs 0: give at least one thread, e.g. --jobs 2"));
+        return Err(CliError::input(
+            "--jobs 0: give at least one thread, e.g. --jobs 2",
+        ));
     }
 
     let total = sweep.cases().len();

@@ -90,8 +90,9 @@ pub struct MonitorOutcome {
 #[derive(Debug, Clone, Serialize)]
 pub struct CaseResult {
     pub case: Case,
+    /// RMS of the broadband noise (white and shaft-modulated), g.
     pub noise_g: f64,
-    /// The fault's RMS over the noise's, dB (`None` for healthy records).
+    /// The fault's RMS over the broadband noise's, dB (`None` for healthy records).
     pub snr_db: Option<f64>,
     /// `Err`: the record could not be analysed (the message says why); counts as a miss.
     pub record: Result<RecordOutcome, String>,
@@ -194,27 +195,32 @@ pub fn run_case(
     let machine = &sweep.machines[case.machine];
     let mut params = params_of(case, machine, &sweep.nuisance);
     let fault_rms = fault_rms_g(&params);
-    params.noise_g = match case.noise {
-        NoiseLevel::SimulatorDefault => params.noise_g,
-        NoiseLevel::Snr(db) => {
-            let reference = if case.fault == SimulatedFault::None {
-                let outer = Case {
-                    fault: SimulatedFault::OuterRace,
-                    severity: DEFAULT_SEVERITY,
-                    ..case.clone()
-                };
-                fault_rms_g(&params_of(&outer, machine, &Nuisance::none()))
-            } else {
-                fault_rms
+    // The broadband noise is the white noise and the nuisance's shaft-modulated noise
+    // together: an SNR sets both, in the preset's proportion between them.
+    let modulation_power = 1.0 + 0.5 * params.nuisance.modulation_depth.powi(2);
+    let modulated_per_white = params.nuisance.modulated_noise_g / params.noise_g.max(1e-12);
+    let broadband_per_white = (1.0 + modulated_per_white.powi(2) * modulation_power).sqrt();
+    if let NoiseLevel::Snr(db) = case.noise {
+        let reference = if case.fault == SimulatedFault::None {
+            let outer = Case {
+                fault: SimulatedFault::OuterRace,
+                severity: DEFAULT_SEVERITY,
+                ..case.clone()
             };
-            reference / 10f64.powf(db / 20.0)
-        }
-    };
-    let snr_db = (case.fault != SimulatedFault::None && params.noise_g > 0.0)
-        .then(|| 20.0 * (fault_rms / params.noise_g).log10());
+            fault_rms_g(&params_of(&outer, machine, &Nuisance::none()))
+        } else {
+            fault_rms
+        };
+        let broadband = reference / 10f64.powf(db / 20.0);
+        params.noise_g = broadband / broadband_per_white;
+        params.nuisance.modulated_noise_g = modulated_per_white * params.noise_g;
+    }
+    let broadband_g = params.noise_g * broadband_per_white;
+    let snr_db = (case.fault != SimulatedFault::None && broadband_g > 0.0)
+        .then(|| 20.0 * (fault_rms / broadband_g).log10());
     let freqs = params.frequencies();
     let fs = params.fs_hz;
-    let noise_g = params.noise_g;
+    let noise_g = broadband_g;
     let signal = Simulator::record(params, sweep.monitor_s);
 
     let record_len = ((sweep.record_s * fs).round() as usize).min(signal.len());

@@ -215,12 +215,11 @@ pub fn render_tables(summary: &Summary) -> String {
         for kind in FaultKind::ALL {
             let _ = write!(out, "{:<12}", kind.name());
             for level in &summary.noise_levels {
-                let rate = p
-                    .pd
-                    .get(kind.name())
-                    .and_then(|row| row.get(level))
-                    .copied()
-                    .unwrap_or_default();
+                let rate =
+                    p.pd.get(kind.name())
+                        .and_then(|row| row.get(level))
+                        .copied()
+                        .unwrap_or_default();
                 let cell = format!("{} ({}/{})", rate.percent(), rate.hits, rate.trials);
                 let _ = write!(out, "{cell:>13}");
             }
@@ -304,7 +303,11 @@ pub fn render_csv(results: &[CaseResult]) -> String {
     for r in results {
         let (verdict, confidence, scores) = match &r.record {
             Ok(o) => (o.verdict.clone(), format!("{:.3}", o.confidence), o.scores),
-            Err(e) => (format!("error: {}", e.replace(',', ";")), String::new(), [0.0; 4]),
+            Err(e) => (
+                format!("error: {}", e.replace(',', ";")),
+                String::new(),
+                [0.0; 4],
+            ),
         };
         let _ = writeln!(
             out,

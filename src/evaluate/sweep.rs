@@ -32,8 +32,21 @@ impl Machine {
         }
     }
 
+    /// The IMS rig: Rexnord ZA-2115 (16 rollers, contact angle 15.17°) at 2000 rpm, 20.48 kHz;
+    /// resonance 4 kHz (choice).
+    pub fn ims() -> Self {
+        Machine {
+            bearing: BearingGeometry::from_catalog("rexnord-za-2115").expect("catalog entry"),
+            nominal_rpm: 2000.0,
+            fs_hz: 20_480.0,
+            resonance_hz: 4_000.0,
+        }
+    }
+
     /// Seed 002's test stand: SKF 61804 at 3000 rpm; sampled at the daemon's default
-    /// 25.6 kHz, resonance 5 kHz (choice).
+    /// 25.6 kHz, resonance 5 kHz (choice). A hard case on purpose: its BPFI (7.375 × fr) and
+    /// 2·BSF (7.294 × fr) lie 1.1 % apart, inside the ±2 % slip tolerance, so only the
+    /// sidebands (±fr against ±FTF) can tell an inner-race from a ball fault.
     pub fn siegen() -> Self {
         Machine {
             bearing: BearingGeometry::from_catalog("skf-61804").expect("catalog entry"),
@@ -51,9 +64,11 @@ pub enum NoiseLevel {
     /// The simulator's own default, [`SimulationParams::example`]'s `noise_g` (0.2 g).
     SimulatorDefault,
     /// Fault-to-noise power ratio in dB: the RMS of the fault's own signal (impacts and, for a
-    /// cage, rubbing; measured on a noiseless simulation of the same case) over the white
-    /// noise's RMS. Healthy cases take the noise of an outer-race fault of the default
-    /// severity on the same machine and speed.
+    /// cage, rubbing; measured on a noiseless simulation of the same case) over the RMS of the
+    /// broadband noise (the white noise and the nuisance's shaft-modulated noise, kept in the
+    /// preset's proportion). Healthy cases take the noise of an outer-race fault of the
+    /// default severity on the same machine and speed. The nuisance's tones and random
+    /// impulses keep their levels: severity is the fault's strength against them.
     Snr(f64),
 }
 
@@ -98,13 +113,13 @@ pub struct Sweep {
 pub const DEFAULT_SEVERITY: f64 = 1.0;
 
 impl Sweep {
-    /// The small sweep CI runs: both machines at their nominal speed, the default severity and
-    /// the simulator's default noise, plus 0 dB; three healthy records each.
+    /// The small sweep CI runs: two machines (CWRU, IMS) at their nominal speed, the default
+    /// severity and the simulator's default noise, plus 0 dB; three healthy records each.
     pub fn quick(seed: u64) -> Self {
         Sweep {
             name: "quick".into(),
             seed,
-            machines: vec![Machine::cwru(), Machine::siegen()],
+            machines: vec![Machine::cwru(), Machine::ims()],
             speed_factors: vec![1.0],
             severities: vec![DEFAULT_SEVERITY],
             noise: vec![NoiseLevel::SimulatorDefault, NoiseLevel::Snr(0.0)],
@@ -115,10 +130,12 @@ impl Sweep {
         }
     }
 
-    /// The full sweep: two speeds, three severities, six SNRs and the default noise.
+    /// The full sweep: three machines (the quick two and seed 002's SKF 61804), two speeds,
+    /// three severities, six SNRs and the default noise.
     pub fn full(seed: u64) -> Self {
         Sweep {
             name: "full".into(),
+            machines: vec![Machine::cwru(), Machine::ims(), Machine::siegen()],
             speed_factors: vec![0.6, 1.0],
             severities: vec![0.5, DEFAULT_SEVERITY, 2.0],
             noise: vec![
@@ -224,7 +241,10 @@ mod tests {
             .iter()
             .filter(|c| full.iter().any(|f| f == *c))
             .count();
-        assert!(shared >= 8, "only {shared} quick cases found in the full sweep");
+        assert!(
+            shared >= 8,
+            "only {shared} quick cases found in the full sweep"
+        );
         let mut seeds: Vec<u64> = full.iter().map(|c| c.seed).collect();
         seeds.sort_unstable();
         seeds.dedup();
@@ -238,7 +258,7 @@ mod tests {
         for fault in SimulatedFault::ALL {
             assert!(cases.iter().any(|c| c.fault == fault), "{fault:?} missing");
         }
-        // 2 machines × 2 speeds × 7 noise levels × (4 faults × 3 severities + 3 healthy).
-        assert_eq!(cases.len(), 2 * 2 * 7 * (4 * 3 + 3));
+        // 3 machines × 2 speeds × 7 noise levels × (4 faults × 3 severities + 3 healthy).
+        assert_eq!(cases.len(), 3 * 2 * 7 * (4 * 3 + 3));
     }
 }
