@@ -8,37 +8,9 @@
 //! the calibrated decision (issue 16, item 1) lands. Do not loosen it to pass; the failure
 //! message lists every failing case with its scores, for tuning.
 
-use bearingd::analysis::FaultKind;
 use bearingd::evaluate::summary::{detected, is_confident_wrong};
 use bearingd::evaluate::{run_sweep, Bench, CaseResult, NoiseLevel, Path, Predicted, Sweep};
 use bearingd::twin::SimulatedFault;
-
-fn describe(r: &CaseResult) -> String {
-    let record = match &r.record {
-        Ok(o) => format!(
-            "analyze: {} ({:.2}; scores outer {:.1} inner {:.1} ball {:.1} cage {:.1}; {})",
-            o.verdict, o.confidence, o.scores[0], o.scores[1], o.scores[2], o.scores[3], o.reason
-        ),
-        Err(e) => format!("analyze failed: {e}"),
-    };
-    let flags: Vec<String> = FaultKind::ALL
-        .iter()
-        .zip(r.monitor.highest)
-        .map(|(k, l)| format!("{} {}", k.name(), l.name()))
-        .collect();
-    format!(
-        "{} on {} at {:.0} rpm, severity {} g, noise {} ({:.3} g{}): {record}; monitor flags: {}",
-        r.case.fault.name(),
-        r.case.bearing,
-        r.case.rpm,
-        r.case.severity,
-        r.case.noise.label(),
-        r.noise_g,
-        r.snr_db
-            .map_or(String::new(), |s| format!(", SNR {s:+.1} dB")),
-        flags.join(", ")
-    )
-}
 
 #[test]
 fn issue16_quick_sweep_flags_every_fault_and_no_healthy_bearing() {
@@ -69,7 +41,7 @@ fn issue16_quick_sweep_flags_every_fault_and_no_healthy_bearing() {
     for r in &defaults {
         for path in Path::BOTH {
             if !detected(path, r) {
-                failures.push(format!("MISSED by {path:?}: {}", describe(r)));
+                failures.push(format!("MISSED by {path:?}: {}", r.describe()));
             }
         }
     }
@@ -86,7 +58,7 @@ fn issue16_quick_sweep_flags_every_fault_and_no_healthy_bearing() {
     for r in &healthy {
         for path in Path::BOTH {
             if path.predicted(r) != Predicted::None {
-                failures.push(format!("FALSE ALARM by {path:?}: {}", describe(r)));
+                failures.push(format!("FALSE ALARM by {path:?}: {}", r.describe()));
             }
         }
         assert!(
@@ -103,7 +75,7 @@ fn issue16_quick_sweep_flags_every_fault_and_no_healthy_bearing() {
                 failures.push(format!(
                     "CONFIDENT WRONG by {path:?} (said {}): {}",
                     path.predicted(r).name(),
-                    describe(r)
+                    r.describe()
                 ));
             }
         }

@@ -104,6 +104,41 @@ impl CaseResult {
         self.case.fault.kind()
     }
 
+    /// One line saying what was simulated and what both paths made of it (for test failures
+    /// and logs).
+    pub fn describe(&self) -> String {
+        let record = match &self.record {
+            Ok(o) => format!(
+                "analyze: {} ({:.2}; scores outer {:.1} inner {:.1} ball {:.1} cage {:.1}; {})",
+                o.verdict,
+                o.confidence,
+                o.scores[0],
+                o.scores[1],
+                o.scores[2],
+                o.scores[3],
+                o.reason
+            ),
+            Err(e) => format!("analyze failed: {e}"),
+        };
+        let flags: Vec<String> = FaultKind::ALL
+            .iter()
+            .zip(self.monitor.highest)
+            .map(|(k, l)| format!("{} {}", k.name(), l.name()))
+            .collect();
+        format!(
+            "{} on {} at {:.0} rpm, severity {} g, noise {} ({:.3} g{}): {record}; monitor flags: {}",
+            self.case.fault.name(),
+            self.case.bearing,
+            self.case.rpm,
+            self.case.severity,
+            self.case.noise.label(),
+            self.noise_g,
+            self.snr_db
+                .map_or(String::new(), |s| format!(", SNR {s:+.1} dB")),
+            flags.join(", ")
+        )
+    }
+
     pub fn record_predicted(&self) -> Predicted {
         self.record
             .as_ref()
