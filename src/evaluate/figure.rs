@@ -21,10 +21,14 @@ pub fn pd_figure(summary: &Summary, sweep_name: &str) -> Figure {
         "Detection probability vs SNR ({sweep_name} sweep, {} runs)",
         summary.runs
     ))
-    .with_note("SNR: RMS of the fault's own signal over the white noise's, dB; nuisance on")
+    .with_note("SNR: fault RMS over broadband noise RMS (white + shaft-modulated), dB")
     .with_note("each point: every severity, speed and bearing at that SNR");
     for p in &summary.paths {
-        let mut panel = SpectrumPanel::new("SNR (dB)", "Pd", x.clone());
+        let y_label = match p.path {
+            Path::Record => "Pd, analyze (verdict)",
+            Path::Monitor => "Pd, monitor (flag)",
+        };
+        let mut panel = SpectrumPanel::new("SNR (dB)", y_label, x.clone());
         panel.series.push(Series {
             label: "Pd = 1".into(),
             y: vec![1.0; x.len()],
