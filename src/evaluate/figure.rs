@@ -2,7 +2,7 @@
 //! panel per path, drawn with the project's plot code.
 
 use super::summary::{Path, Summary};
-use crate::analysis::FaultKind;
+use crate::messages::FaultKind;
 use crate::plot::{Color, Figure, Series, SpectrumPanel};
 
 /// Pd vs SNR per fault type (the simulator-default noise level has no SNR of its own and is

@@ -7,12 +7,13 @@
 //!   as the sensor's integer counts in blocks with their sample positions, in sample time.
 
 use super::sweep::{Case, Machine, NoiseLevel, Sweep, DEFAULT_SEVERITY};
-use crate::analysis::flags::FlagLevel;
 use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
 use crate::analysis::record::RecordAnalyzer;
-use crate::analysis::{AnalysisSettings, Diagnosis, FaultKind, Verdict};
+use crate::analysis::{AnalysisSettings, Diagnosis, Verdict};
 use crate::config::{Config, SensorConfig, SimConfig, Speed, Transport};
-use crate::daemon::pipeline::monitor_settings;
+use crate::messages::FaultKind;
+use crate::messages::FlagLevel;
+use crate::pipeline::monitor_settings;
 use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
 use serde::Serialize;
 

@@ -4,7 +4,7 @@
 
 use super::run::{CaseResult, Predicted};
 use super::sweep::{NoiseLevel, DEFAULT_SEVERITY};
-use crate::analysis::FaultKind;
+use crate::messages::FaultKind;
 use crate::twin::SimulatedFault;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -116,7 +116,7 @@ pub fn detected(path: Path, result: &CaseResult) -> bool {
         Path::Record => result.record_predicted() == Predicted::Fault(truth),
         Path::Monitor => {
             let index = FaultKind::ALL.iter().position(|&k| k == truth).unwrap_or(0);
-            result.monitor.highest[index] > crate::analysis::flags::FlagLevel::Ok
+            result.monitor.highest[index] > crate::messages::FlagLevel::Ok
         }
     }
 }
