@@ -12,6 +12,8 @@
 //!   sample time, counting gaps, restarts, silent sensors and malformed frames.
 //! - [`sinks`]: where the pipeline's messages go: the MCAP log writer, iceoryx2 alerts, the
 //!   systemd notify protocol.
+//! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
+//!   SNR, speed and bearing through the real pipeline (`bearingd evaluate`).
 //! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
 //! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
@@ -41,6 +43,7 @@ pub mod bearing;
 pub mod cli;
 pub mod config;
 pub mod daemon;
+pub mod evaluate;
 pub mod iox;
 pub mod mcap_log;
 pub mod messages;

@@ -7,6 +7,11 @@
 //! - large enough to matter: its score (geometric-mean peak-to-floor ratio) ≥ `min_fault_score`.
 //!   Real machines carry lines no noise model predicts; this floor sits above what healthy
 //!   machines and other faults' stray lines reach in the simulator sweep and the dev data.
+//!   Those lines lift several combs at once (a cluttered spectrum scores 2–4 for two or three
+//!   faults), so a weaker comb is also *detected* when it stands alone: score ≥
+//!   `lone_fault_score`, ≥ `lone_score_ratio` × every other hypothesis once it is explained away,
+//!   significant at the square of the false-alarm rate (a weaker comb needs stronger proof
+//!   that it is not noise), and every harmonic but one standing clear of the floor.
 //!
 //! The strongest hypothesis leads; the others are re-scored with its comb explained away. A
 //! leader is named when it is detected and no other hypothesis is detected on the evidence the
@@ -80,6 +85,8 @@ pub struct DecisionRule {
     pub false_alarm_rate: f64,
     pub min_fault_score: f64,
     pub min_score_ratio: f64,
+    pub lone_fault_score: f64,
+    pub lone_score_ratio: f64,
 }
 
 impl DecisionRule {
@@ -94,10 +101,34 @@ impl DecisionRule {
         score.significance >= self.min_significance()
     }
 
-    /// Significant and large enough to name.
+    /// Significant and large enough to name whatever else the spectrum holds.
     pub fn detected(&self, score: &FaultScore) -> bool {
         self.significant(score) && score.score >= self.min_fault_score
     }
+
+    /// Large enough to name when it stands alone (`runner_up`: the strongest other hypothesis
+    /// once this one is explained away, 1 for none).
+    fn detected_alone(&self, score: &FaultScore, runner_up: f64) -> bool {
+        score.significance >= 2.0 * self.min_significance()
+            && score.score >= self.lone_fault_score
+            && score.score >= self.lone_score_ratio * runner_up.max(1.0)
+            && score.harmonics_stand(LONE_HARMONIC_RATIO)
+    }
+}
+
+/// (choice) A comb named because it stands alone has every harmonic but one at least this many
+/// times its floor: on the simulator's machine (gear mesh, 100 Hz tone, shaft harmonics) the
+/// stray combs of healthy records at 0.6× speed reach 2–3 with two tall lines and three at the
+/// floor, while the weakest faults it should name show 2.7–3.8 on all five.
+const LONE_HARMONIC_RATIO: f64 = 2.0;
+
+/// How the leader of a [`Contest`] was named.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Named {
+    /// Its comb is large enough whatever else the spectrum holds ([`DecisionRule::detected`]).
+    BySize,
+    /// A weaker comb with nothing near it (`lone_fault_score`, `lone_score_ratio`).
+    Alone,
 }
 
 /// The strongest hypothesis and the strongest of the others once the leader is explained away.
@@ -109,10 +140,14 @@ pub struct Contest<'a> {
 }
 
 impl<'a> Contest<'a> {
-    /// `scores`: every hypothesis; `explained`: the others re-scored with the leader (the
-    /// highest score in `scores`) explained away. `None` when nothing was scored.
-    pub fn new(scores: &'a [FaultScore], explained: &'a [FaultScore]) -> Option<Self> {
-        let leader = scores.iter().max_by(|a, b| a.score.total_cmp(&b.score))?;
+    /// `scores`: every hypothesis; `explained`: the others re-scored with the leader (see
+    /// [`leader`]) explained away. `None` when nothing was scored.
+    pub fn new(
+        scores: &'a [FaultScore],
+        explained: &'a [FaultScore],
+        rule: &DecisionRule,
+    ) -> Option<Self> {
+        let leader = leader(scores, rule)?;
         let runner_up = explained
             .iter()
             .filter(|s| s.fault != leader.fault)
@@ -121,9 +156,29 @@ impl<'a> Contest<'a> {
     }
 
     /// The leader, when it is significant and separable from every other significant
-    /// hypothesis: the fault the daemon's flags follow.
-    pub fn lead(&self, rule: &DecisionRule) -> Option<FaultKind> {
-        (rule.significant(self.leader) && self.separated(rule)).then_some(self.leader.fault)
+    /// hypothesis: the fault the daemon's flags follow (its flag's thresholds then act on the
+    /// score), and whether it stands alone (then its flag rises to watch at least).
+    pub fn lead(&self, rule: &DecisionRule) -> Option<(FaultKind, Named)> {
+        if self.named(rule) == Some(Named::Alone) {
+            return Some((self.leader.fault, Named::Alone));
+        }
+        (rule.significant(self.leader) && self.separated(rule))
+            .then_some((self.leader.fault, Named::BySize))
+    }
+
+    /// How the leader is named, if it is.
+    pub fn named(&self, rule: &DecisionRule) -> Option<Named> {
+        if rule.detected(self.leader) && self.separated(rule) {
+            Some(Named::BySize)
+        } else if rule.detected_alone(self.leader, self.runner_up_score()) {
+            Some(Named::Alone)
+        } else {
+            None
+        }
+    }
+
+    fn runner_up_score(&self) -> f64 {
+        self.runner_up.map_or(1.0, |r| r.score)
     }
 
     fn runner_up_detected(&self, rule: &DecisionRule) -> bool {
@@ -131,7 +186,7 @@ impl<'a> Contest<'a> {
     }
 
     fn ratio(&self) -> f64 {
-        self.leader.score / self.runner_up.map_or(1.0, |r| r.score.max(1e-9))
+        self.leader.score / self.runner_up_score().max(1e-9)
     }
 
     fn separated(&self, rule: &DecisionRule) -> bool {
@@ -139,26 +194,50 @@ impl<'a> Contest<'a> {
     }
 }
 
-/// How far a fault's `score` is from the decision boundary, in log units (positive: a fault),
-/// and the confidence that gives, in [0.5, 1]. Both conditions (`score ≥ min_fault_score`,
-/// `score ≥ min_score_ratio × runner_up`) count, so the weaker one counts.
-pub fn score_evidence(
-    score: f64,
-    runner_up: f64,
-    min_fault_score: f64,
-    min_score_ratio: f64,
-) -> (f64, f64) {
+/// The hypothesis that leads: the highest score, except that a cage comb gives way to an
+/// outer-race or ball comb that is significant and at least `lone_fault_score`, or however
+/// small, significant at `false_alarm_rate²`. Both faults make a cage comb of their own (an
+/// outer-race defect is met by balls the cage carries; a damaged ball is carried through the
+/// load zone once per cage turn, so its impacts swell and fade at FTF), often a taller one than
+/// their own, and it outlasts their own comb in noise; a damaged cage makes no race or ball
+/// comb.
+pub fn leader<'a>(scores: &'a [FaultScore], rule: &DecisionRule) -> Option<&'a FaultScore> {
+    let top = scores.iter().max_by(|a, b| a.score.total_cmp(&b.score))?;
+    if top.fault != FaultKind::Cage {
+        return Some(top);
+    }
+    let cause = scores
+        .iter()
+        .filter(|s| matches!(s.fault, FaultKind::OuterRace | FaultKind::Ball))
+        .filter(|s| {
+            (rule.significant(s) && s.score >= rule.lone_fault_score)
+                || s.significance >= 2.0 * rule.min_significance()
+        })
+        .max_by(|a, b| a.score.total_cmp(&b.score));
+    Some(cause.unwrap_or(top))
+}
+
+/// How far a fault's `score` is from the decision boundary on scores alone (the alert's view:
+/// its significance was checked when its flag rose), in log units (positive: a fault), and the
+/// confidence that gives, in [0.5, 1]. Either way of naming counts (large enough and
+/// `min_score_ratio` × the runner-up, or alone: `lone_fault_score` and `lone_score_ratio` ×);
+/// within each, the weaker condition counts.
+pub fn score_evidence(score: f64, runner_up: f64, rule: &DecisionRule) -> (f64, f64) {
     let ratio = score / runner_up.max(1e-9);
-    let evidence = (score.max(1e-9) / min_fault_score)
+    let by_size = (score.max(1e-9) / rule.min_fault_score)
         .ln()
-        .min((ratio / min_score_ratio).ln());
+        .min((ratio / rule.min_score_ratio).ln());
+    let alone = (score.max(1e-9) / rule.lone_fault_score)
+        .ln()
+        .min((score / runner_up.max(1.0) / rule.lone_score_ratio).ln());
+    let evidence = by_size.max(alone);
     (evidence, 1.0 - 0.5 * (-2.0 * evidence.abs()).exp())
 }
 
 /// Decides from the scores of every fault kind (`scores`) and the others' scores with the
 /// leader explained away (`explained`; see [`Contest::new`]).
 pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &DecisionRule) -> Diagnosis {
-    let Some(contest) = Contest::new(scores, explained) else {
+    let Some(contest) = Contest::new(scores, explained, rule) else {
         return Diagnosis {
             verdict: Verdict::None,
             confidence: 0.5,
@@ -189,9 +268,16 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
     } else {
         f64::INFINITY
     };
-    let evidence = size_evidence
+    let by_size = size_evidence
         .min(significance_evidence)
         .min(separation_evidence);
+    let alone_ratio = best.score / runner_score.max(1.0);
+    let alone = (best.score.max(1e-9) / rule.lone_fault_score)
+        .ln()
+        .min((alone_ratio / rule.lone_score_ratio).ln())
+        .min((best.significance - 2.0 * min_sig) * std::f64::consts::LN_10);
+    // Either way of naming suffices: the evidence is the better of the two.
+    let evidence = by_size.max(alone);
     let confidence = 1.0 - 0.5 * (-2.0 * evidence.abs()).exp();
     let header = format!(
         "{} score {:.1} (noise would give it with p = 10^-{:.1})",
@@ -199,22 +285,43 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
         best.score,
         best.significance
     );
-    if rule.detected(best) && contest.separated(rule) {
-        return Diagnosis {
-            verdict: best.fault.into(),
-            confidence,
-            candidates: Vec::new(),
-            reason: format!(
-                "{header} ≥ {:.1}, p ≤ {:.0e}; runner-up {runner_text}",
-                rule.min_fault_score, rule.false_alarm_rate
-            ),
-        };
+    match contest.named(rule) {
+        Some(Named::BySize) => {
+            return Diagnosis {
+                verdict: best.fault.into(),
+                confidence,
+                candidates: Vec::new(),
+                reason: format!(
+                    "{header} ≥ {:.1}, p ≤ {:.0e}; runner-up {runner_text}",
+                    rule.min_fault_score, rule.false_alarm_rate
+                ),
+            }
+        }
+        Some(Named::Alone) => {
+            return Diagnosis {
+                verdict: best.fault.into(),
+                confidence,
+                candidates: Vec::new(),
+                reason: format!(
+                    "{header} stands alone: ≥ {:.1}, {alone_ratio:.1}× the runner-up {runner_text} \
+                     (needs {:.1}×), p ≤ {:.0e}",
+                    rule.lone_fault_score,
+                    rule.lone_score_ratio,
+                    rule.false_alarm_rate * rule.false_alarm_rate
+                ),
+            }
+        }
+        None => {}
     }
     let (candidates, why) = if !rule.detected(best) {
         let what = if !rule.significant(best) {
             format!("not significant (needs p ≤ {:.0e})", rule.false_alarm_rate)
         } else {
-            format!("below {:.1}", rule.min_fault_score)
+            format!(
+                "below {:.1} and not alone ({alone_ratio:.1}× the runner-up; alone needs ≥ {:.1} \
+                 and {:.1}×)",
+                rule.min_fault_score, rule.lone_fault_score, rule.lone_score_ratio
+            )
         };
         (Vec::new(), format!("{header} is {what}"))
     } else {
@@ -233,5 +340,146 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
         confidence,
         candidates,
         reason: format!("no clear fault: {why}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::AnalysisSettings;
+    use crate::bearing::BearingGeometry;
+
+    fn rule() -> DecisionRule {
+        AnalysisSettings::default().decision_rule()
+    }
+
+    /// Scores in [`FaultKind::ALL`] order: (score, significance) each.
+    fn scores(values: [(f64, f64); 4]) -> Vec<FaultScore> {
+        let freqs = BearingGeometry::from_catalog("skf-6205-2rs")
+            .expect("a catalog bearing")
+            .fault_frequencies(29.5);
+        FaultKind::ALL
+            .iter()
+            .zip(values)
+            .map(|(&kind, (score, significance))| {
+                let mut s = FaultScore::unscored(kind, &freqs).with_harmonic_ratios(&[score; 5]);
+                s.score = score;
+                s.significance = significance;
+                s
+            })
+            .collect()
+    }
+
+    /// The others as `explained` (the test's leader explains nothing of theirs).
+    fn verdict(values: [(f64, f64); 4]) -> Diagnosis {
+        let all = scores(values);
+        let rule = rule();
+        let top = leader(&all, &rule).expect("scored").fault;
+        let explained: Vec<FaultScore> = all.iter().filter(|s| s.fault != top).copied().collect();
+        diagnose(&all, &explained, &rule)
+    }
+
+    #[test]
+    fn a_large_significant_comb_is_named() {
+        let d = verdict([(1.5, 0.5), (8.0, 20.0), (2.0, 1.0), (1.4, 0.2)]);
+        assert_eq!(d.verdict, Verdict::InnerRace, "{}", d.reason);
+        assert!(d.confidence > 0.6);
+    }
+
+    #[test]
+    fn a_weaker_comb_is_named_when_it_stands_alone_and_not_in_clutter() {
+        // Alone: 3.5, 2.3× the next, p = 10^-30.
+        let d = verdict([(1.5, 0.5), (3.5, 30.0), (1.4, 1.0), (1.3, 0.2)]);
+        assert_eq!(d.verdict, Verdict::InnerRace, "{}", d.reason);
+        assert!(d.reason.contains("stands alone"), "{}", d.reason);
+        // The same comb beside another comb at 2.6 (a machine's lines): no.
+        let d = verdict([(2.6, 4.0), (3.5, 30.0), (1.4, 1.0), (1.3, 0.2)]);
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+        // Alone but barely beyond noise (p = 10^-4 < the 10^-6 a weak comb needs): no.
+        let d = verdict([(1.2, 0.5), (3.5, 4.0), (1.2, 1.0), (1.1, 0.2)]);
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+        // Below the lone floor: no.
+        let d = verdict([(1.0, 0.0), (2.9, 30.0), (1.0, 0.0), (1.0, 0.0)]);
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+    }
+
+    #[test]
+    fn a_lone_comb_of_two_tall_lines_is_a_machines_not_a_fault() {
+        let freqs = BearingGeometry::from_catalog("skf-6205-2rs")
+            .expect("a catalog bearing")
+            .fault_frequencies(29.5);
+        let mut all = scores([(3.4, 30.0), (1.4, 1.0), (1.3, 1.0), (1.2, 0.2)]);
+        let consistent = verdict([(3.4, 30.0), (1.4, 1.0), (1.3, 1.0), (1.2, 0.2)]);
+        assert_eq!(
+            consistent.verdict,
+            Verdict::OuterRace,
+            "{}",
+            consistent.reason
+        );
+        let mut tones = FaultScore::unscored(FaultKind::OuterRace, &freqs)
+            .with_harmonic_ratios(&[8.0, 1.0, 1.1, 1.2, 9.0]);
+        tones.score = 3.4;
+        tones.significance = 30.0;
+        all[0] = tones;
+        let explained: Vec<FaultScore> = all[1..].to_vec();
+        let d = diagnose(&all, &explained, &rule());
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+    }
+
+    #[test]
+    fn a_cage_comb_gives_way_to_the_ball_or_race_comb_that_makes_it() {
+        // A damaged ball: its cage comb is taller than its own.
+        let all = scores([(1.5, 0.5), (2.0, 1.0), (4.6, 40.0), (6.5, 20.0)]);
+        assert_eq!(
+            leader(&all, &rule()).map(|l| l.fault),
+            Some(FaultKind::Ball)
+        );
+        // A damaged cage: nothing else significant, the cage leads.
+        let all = scores([(1.5, 0.5), (1.3, 1.0), (1.2, 0.4), (7.9, 20.0)]);
+        assert_eq!(
+            leader(&all, &rule()).map(|l| l.fault),
+            Some(FaultKind::Cage)
+        );
+        let d = verdict([(1.5, 0.5), (1.3, 1.0), (1.2, 0.4), (7.9, 20.0)]);
+        assert_eq!(d.verdict, Verdict::Cage, "{}", d.reason);
+        // A ball buried in noise: its own comb small but far beyond noise, its cage comb tall.
+        // The ball leads and, too small to name, gives none; never "cage".
+        let all = scores([(1.3, 0.5), (1.6, 11.0), (2.5, 26.0), (4.9, 23.0)]);
+        assert_eq!(
+            leader(&all, &rule()).map(|l| l.fault),
+            Some(FaultKind::Ball)
+        );
+        let d = verdict([(1.3, 0.5), (1.6, 11.0), (2.5, 26.0), (4.9, 23.0)]);
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+        // A significant but small ball comb does not take the lead from a cage.
+        let all = scores([(1.5, 0.5), (1.3, 1.0), (2.2, 4.0), (7.9, 20.0)]);
+        assert_eq!(
+            leader(&all, &rule()).map(|l| l.fault),
+            Some(FaultKind::Cage)
+        );
+    }
+
+    #[test]
+    fn two_detected_combs_close_together_give_none_with_both_named() {
+        let d = verdict([(6.0, 10.0), (7.0, 12.0), (1.4, 1.0), (1.3, 0.2)]);
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+        assert_eq!(
+            d.candidates,
+            vec![FaultKind::InnerRace, FaultKind::OuterRace]
+        );
+    }
+
+    #[test]
+    fn the_alert_confidence_counts_either_way_of_naming() {
+        let rule = rule();
+        let (alone, _) = score_evidence(3.5, 1.4, &rule);
+        assert!(
+            alone > 0.0,
+            "a lone comb at 3.5 is on the fault side: {alone}"
+        );
+        let (cluttered, _) = score_evidence(3.5, 2.6, &rule);
+        assert!(cluttered < 0.0, "{cluttered}");
+        let (large, _) = score_evidence(9.0, 2.6, &rule);
+        assert!(large > 0.0, "{large}");
     }
 }

@@ -49,6 +49,10 @@ impl FaultFlag {
         self.level
     }
 
+    pub fn settings(&self) -> &FlagSettings {
+        &self.settings
+    }
+
     fn threshold(&self, level: FlagLevel) -> f64 {
         match level {
             FlagLevel::Ok => 0.0,

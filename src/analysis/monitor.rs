@@ -36,7 +36,7 @@
 use super::band_selection::{
     scaled, usable_shaft_hz, BandJob, BandResult, BandSelector, InlineSelector,
 };
-use super::diagnosis::Contest;
+use super::diagnosis::{leader, Contest, Named};
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::{FaultFlag, FlagChange, FlagSettings};
@@ -518,8 +518,8 @@ impl ChannelMonitor {
             if *bands_known && speed_known {
                 // Only the leading fault feeds its flag (the verdict's rule); the others see 0
                 // and fall.
-                let leader = (0..4)
-                    .max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))
+                let leader = leader(&scores[..], &rule)
+                    .and_then(|l| FaultKind::ALL.iter().position(|&k| k == l.fault))
                     .unwrap_or(0);
                 for (i, kind) in FaultKind::ALL.iter().enumerate() {
                     explained[i] = if i == leader {
@@ -538,12 +538,16 @@ impl ChannelMonitor {
                         )
                     };
                 }
-                let lead = Contest::new(&scores[..], &explained[..]).and_then(|c| c.lead(&rule));
+                let lead =
+                    Contest::new(&scores[..], &explained[..], &rule).and_then(|c| c.lead(&rule));
                 for (i, kind) in FaultKind::ALL.iter().enumerate() {
-                    let score = if lead == Some(*kind) {
-                        scores[i].score
-                    } else {
-                        0.0
+                    let score = match lead {
+                        Some((fault, Named::BySize)) if fault == *kind => scores[i].score,
+                        // A comb named because it stands alone is at watch at least.
+                        Some((fault, Named::Alone)) if fault == *kind => {
+                            scores[i].score.max(flags[i].settings().watch_score)
+                        }
+                        _ => 0.0,
                     };
                     if let Some(change) = flags[i].update(score, update.end_sample) {
                         on_event(MonitorEvent::Flag {

@@ -7,7 +7,7 @@
 //! bound). Band selection can thereby only add evidence, never cut it away.
 
 use super::band::Band;
-use super::diagnosis::{diagnose, Contest, Diagnosis};
+use super::diagnosis::{diagnose, leader, Diagnosis};
 use super::envelope::{window_samples, EnvelopeSpectrum, FftPlans};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::indicators::Indicators;
@@ -248,15 +248,16 @@ pub fn analyze_with_plans(
             .map(|&kind| best_band(&mut scorer, kind, None))
             .collect();
         let scores: Vec<FaultScore> = hypotheses.iter().map(|h| h.score).collect();
-        let explained: Vec<FaultScore> = match Contest::new(&scores, &[]) {
-            Some(contest) => FaultKind::ALL
+        let rule = settings.decision_rule();
+        let explained: Vec<FaultScore> = match leader(&scores, &rule) {
+            Some(leader) => FaultKind::ALL
                 .iter()
-                .filter(|&&kind| kind != contest.leader.fault)
-                .map(|&kind| best_band(&mut scorer, kind, Some(contest.leader)).score)
+                .filter(|&&kind| kind != leader.fault)
+                .map(|&kind| best_band(&mut scorer, kind, Some(leader)).score)
                 .collect(),
             None => Vec::new(),
         };
-        let diagnosis = diagnose(&scores, &explained, &settings.decision_rule());
+        let diagnosis = diagnose(&scores, &explained, &rule);
         let reported_band_index = diagnosis
             .verdict
             .fault()

@@ -45,6 +45,11 @@ pub struct AnalysisSettings {
     /// ...and it is this many times stronger than any other detected hypothesis once it is
     /// explained away; otherwise the diagnosis is `none` (with both named).
     pub min_score_ratio: f64,
+    /// A weaker comb is named when it stands alone: score ≥ this...
+    pub lone_fault_score: f64,
+    /// ...this many times every other hypothesis once it is explained away, and significant
+    /// at `false_alarm_rate²`.
+    pub lone_score_ratio: f64,
 }
 
 impl AnalysisSettings {
@@ -54,6 +59,8 @@ impl AnalysisSettings {
             false_alarm_rate: self.false_alarm_rate,
             min_fault_score: self.min_fault_score,
             min_score_ratio: self.min_score_ratio,
+            lone_fault_score: self.lone_fault_score,
+            lone_score_ratio: self.lone_score_ratio,
         }
     }
 }
@@ -72,6 +79,8 @@ impl Default for AnalysisSettings {
             false_alarm_rate: 1e-3,
             min_fault_score: 5.0,
             min_score_ratio: 1.5,
+            lone_fault_score: 3.0,
+            lone_score_ratio: 2.0,
         }
     }
 }

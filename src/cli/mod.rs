@@ -9,6 +9,7 @@
 mod alerts;
 mod analyze;
 mod config_cmd;
+mod evaluate;
 mod import;
 mod ingest;
 mod replay;
@@ -94,6 +95,9 @@ enum Command {
     Import(import::ImportArgs),
     /// Replay MCAP logs' raw samples through the same pipeline, as fast as possible or at --speed.
     Replay(replay::ReplayArgs),
+    /// Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records)
+    /// through the real pipeline: detection probability, false alarms, confusion matrix, plot.
+    Evaluate(evaluate::EvaluateArgs),
     /// Write a synthetic record of a bearing fault (the twin's signal model) as CSV or WAV.
     Simulate(simulate::SimulateArgs),
     /// Check a configuration file; lists every problem with its key and how to fix it.
@@ -122,6 +126,7 @@ pub fn main() -> ExitCode {
         Command::Replay(args) => replay::run(&args),
         Command::Import(args) => import::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Evaluate(args) => evaluate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),

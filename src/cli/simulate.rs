@@ -3,7 +3,7 @@
 
 use super::CliError;
 use crate::bearing::BearingGeometry;
-use crate::twin::{SimulatedFault, SimulationParams, Simulator};
+use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
 use clap::{Args, ValueEnum};
 use std::io::Write;
 use std::path::PathBuf;
@@ -14,6 +14,7 @@ pub enum FaultArg {
     Outer,
     Inner,
     Ball,
+    Cage,
 }
 
 #[derive(Args)]
@@ -57,6 +58,10 @@ pub struct SimulateArgs {
     /// White noise, g (standard deviation).
     #[arg(long, default_value_t = 0.2)]
     noise: f64,
+    /// Add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated
+    /// noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md).
+    #[arg(long)]
+    nuisance: bool,
     /// The fault appears at this time, s.
     #[arg(long, default_value_t = 0.0)]
     onset: f64,
@@ -130,6 +135,7 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
             FaultArg::Outer => SimulatedFault::OuterRace,
             FaultArg::Inner => SimulatedFault::InnerRace,
             FaultArg::Ball => SimulatedFault::Ball,
+            FaultArg::Cage => SimulatedFault::Cage,
         },
         rpm: args.rpm,
         bearing: bearing.clone(),
@@ -143,6 +149,11 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         defect_length_mm: args.defect_length,
         noise_g: args.noise,
         shaft_tone_g: 0.05,
+        nuisance: if args.nuisance {
+            Nuisance::typical()
+        } else {
+            Nuisance::none()
+        },
         onset_s: args.onset,
         ramp_s: 0.0,
         seed: args.seed,

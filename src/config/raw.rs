@@ -130,6 +130,8 @@ pub(crate) struct RawAnalysis {
     pub false_alarm_rate: Field<f64>,
     pub min_fault_score: Field<f64>,
     pub min_score_ratio: Field<f64>,
+    pub lone_fault_score: Field<f64>,
+    pub lone_score_ratio: Field<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]

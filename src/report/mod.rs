@@ -179,6 +179,8 @@ pub struct Thresholds {
     pub false_alarm_rate: f64,
     pub min_fault_score: f64,
     pub min_score_ratio: f64,
+    pub lone_fault_score: f64,
+    pub lone_score_ratio: f64,
     pub fault_tolerance: f64,
     pub harmonics: usize,
 }
@@ -254,6 +256,8 @@ impl AnalyzeReport {
                 false_alarm_rate: settings.false_alarm_rate,
                 min_fault_score: settings.min_fault_score,
                 min_score_ratio: settings.min_score_ratio,
+                lone_fault_score: settings.lone_fault_score,
+                lone_score_ratio: settings.lone_score_ratio,
                 fault_tolerance: settings.fault_tolerance,
                 harmonics: settings.harmonics,
             },

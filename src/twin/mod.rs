@@ -10,4 +10,4 @@ pub mod rng;
 pub mod simulate;
 
 pub use fit::{FitBounds, HypothesisFit, TwinFitter, TwinParams};
-pub use simulate::{SimulatedFault, SimulationParams, Simulator};
+pub use simulate::{Nuisance, SimulatedFault, SimulationParams, Simulator};

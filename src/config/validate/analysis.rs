@@ -90,6 +90,22 @@ impl Checker {
             "give how many times the best fault score must exceed the runner-up, at least 1, \
              e.g. min_score_ratio = 1.5",
         );
+        let lone_fault_score = self.number(
+            "analysis.lone_fault_score",
+            &raw.lone_fault_score,
+            d.lone_fault_score,
+            Limits::within(1.0, f64::INFINITY),
+            "give the smallest comb score (at least 1) that makes a diagnosis when no other \
+             fault comes near it, e.g. lone_fault_score = 3.0",
+        );
+        let lone_score_ratio = self.number(
+            "analysis.lone_score_ratio",
+            &raw.lone_score_ratio,
+            d.lone_score_ratio,
+            Limits::within(1.0, f64::INFINITY),
+            "give how many times every other fault a comb below min_fault_score must be to \
+             stand alone, at least 1, e.g. lone_score_ratio = 2.0",
+        );
         Some((
             AnalysisSettings {
                 window_s: window_s?,
@@ -103,6 +119,8 @@ impl Checker {
                 false_alarm_rate: false_alarm_rate?,
                 min_fault_score: min_fault_score?,
                 min_score_ratio: min_score_ratio?,
+                lone_fault_score: lone_fault_score?,
+                lone_score_ratio: lone_score_ratio?,
             },
             band_period_s?,
         ))

@@ -11,7 +11,7 @@
 //! active alert is about to leave the window it is sent again, unchanged, as `repeated`.
 
 use super::payload::{fault_code, name_field, severity_code, Alert, AlertState, ALERT_VERSION};
-use crate::analysis::diagnosis::score_evidence;
+use crate::analysis::diagnosis::{score_evidence, DecisionRule};
 use crate::analysis::AnalysisSettings;
 use crate::messages::{ChannelId, FlagMessage, IndicatorsMessage, PipelineMessage, TwinMessage};
 use crate::messages::{FaultKind, FlagLevel};
@@ -33,8 +33,7 @@ pub struct AlertTracker {
     run_id: u64,
     sequence: u64,
     history_size: u64,
-    min_fault_score: f64,
-    min_score_ratio: f64,
+    rule: DecisionRule,
     rates: HashMap<String, f64>,
     /// Latest fault scores per channel, in [`FaultKind::ALL`] order.
     scores: HashMap<ChannelId, [f64; 4]>,
@@ -64,8 +63,7 @@ impl AlertTracker {
             run_id,
             sequence: 0,
             history_size: history_size.max(2) as u64,
-            min_fault_score: settings.min_fault_score,
-            min_score_ratio: settings.min_score_ratio,
+            rule: settings.decision_rule(),
             rates,
             scores: HashMap::new(),
             twins: HashMap::new(),
@@ -144,12 +142,7 @@ impl AlertTracker {
                 .map(|(_, s)| *s)
                 .fold(1e-9, f64::max)
         });
-        let (_, mut confidence) = score_evidence(
-            flag.score,
-            runner_up,
-            self.min_fault_score,
-            self.min_score_ratio,
-        );
+        let (_, mut confidence) = score_evidence(flag.score, runner_up, &self.rule);
         let twin = self.twins.get(&flag.channel);
         if let (Some(twin), true) = (twin, to != FlagLevel::Ok) {
             if let Some(best) = twin.best {

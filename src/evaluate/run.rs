@@ -1,0 +1,350 @@
+//! One case through the real pipeline, both ways a user meets it:
+//!
+//! - the record path of `bearingd analyze` ([`RecordAnalyzer`] → the diagnosis), on the first
+//!   [`Sweep::record_s`] seconds;
+//! - the daemon's per-channel monitor ([`ChannelMonitor`], as `run` and `replay` drive it, with
+//!   the settings the daemon derives from the embedded default config), fed the whole record
+//!   as the sensor's integer counts in blocks with their sample positions, in sample time.
+
+use super::sweep::{Case, Machine, NoiseLevel, Sweep, DEFAULT_SEVERITY};
+use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
+use crate::analysis::record::RecordAnalyzer;
+use crate::analysis::{AnalysisSettings, Diagnosis, Verdict};
+use crate::config::{Config, SensorConfig, SimConfig, Speed, Transport};
+use crate::messages::FaultKind;
+use crate::messages::FlagLevel;
+use crate::pipeline::monitor_settings;
+use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
+use serde::Serialize;
+
+/// What one path concluded about one record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Predicted {
+    None,
+    Fault(FaultKind),
+    /// The record path declined to pick between named hypotheses (a verdict that is neither
+    /// `none` nor one fault).
+    Ambiguous,
+    /// The monitor raised the flags of more than one fault kind.
+    Several,
+}
+
+impl Predicted {
+    pub fn name(self) -> &'static str {
+        match self {
+            Predicted::None => "none",
+            Predicted::Fault(kind) => kind.name(),
+            Predicted::Ambiguous => "ambiguous",
+            Predicted::Several => "several",
+        }
+    }
+
+    /// The columns of a confusion matrix, in order.
+    pub const COLUMNS: [Predicted; 7] = [
+        Predicted::None,
+        Predicted::Fault(FaultKind::OuterRace),
+        Predicted::Fault(FaultKind::InnerRace),
+        Predicted::Fault(FaultKind::Ball),
+        Predicted::Fault(FaultKind::Cage),
+        Predicted::Ambiguous,
+        Predicted::Several,
+    ];
+
+    /// What a verdict says. Written against the verdict's public meaning (`fault()` names one
+    /// fault or none), so that a verdict added later for "both named, not separable" counts as
+    /// ambiguous without a change here.
+    pub fn of_verdict(verdict: Verdict) -> Self {
+        match verdict.fault() {
+            Some(kind) => Predicted::Fault(kind),
+            None if verdict == Verdict::None => Predicted::None,
+            None => Predicted::Ambiguous,
+        }
+    }
+}
+
+/// The record path's outcome.
+#[derive(Debug, Clone, Serialize)]
+pub struct RecordOutcome {
+    pub verdict: String,
+    pub predicted: Predicted,
+    pub confidence: f64,
+    pub reason: String,
+    /// Fault scores in outer, inner, ball, cage order.
+    pub scores: [f64; 4],
+}
+
+/// The monitor path's outcome.
+#[derive(Debug, Clone, Serialize)]
+pub struct MonitorOutcome {
+    /// The highest level each fault's flag reached (outer, inner, ball, cage).
+    pub highest: [FlagLevel; 4],
+    /// When the first flag rose, s of sample time.
+    pub first_flag_s: Option<f64>,
+    /// Windows scored after the first band selection, and how many of them had a flag up.
+    pub windows_scored: u64,
+    pub windows_flagged: u64,
+    pub predicted: Predicted,
+}
+
+/// One case's results.
+#[derive(Debug, Clone, Serialize)]
+pub struct CaseResult {
+    pub case: Case,
+    /// RMS of the broadband noise (white and shaft-modulated), g.
+    pub noise_g: f64,
+    /// The fault's RMS over the broadband noise's, dB (`None` for healthy records).
+    pub snr_db: Option<f64>,
+    /// `Err`: the record could not be analysed (the message says why); counts as a miss.
+    pub record: Result<RecordOutcome, String>,
+    pub monitor: MonitorOutcome,
+}
+
+impl CaseResult {
+    pub fn truth(&self) -> Option<FaultKind> {
+        self.case.fault.kind()
+    }
+
+    /// One line saying what was simulated and what both paths made of it (for test failures
+    /// and logs).
+    pub fn describe(&self) -> String {
+        let record = match &self.record {
+            Ok(o) => format!(
+                "analyze: {} ({:.2}; scores outer {:.1} inner {:.1} ball {:.1} cage {:.1}; {})",
+                o.verdict,
+                o.confidence,
+                o.scores[0],
+                o.scores[1],
+                o.scores[2],
+                o.scores[3],
+                o.reason
+            ),
+            Err(e) => format!("analyze failed: {e}"),
+        };
+        let flags: Vec<String> = FaultKind::ALL
+            .iter()
+            .zip(self.monitor.highest)
+            .map(|(k, l)| format!("{} {}", k.name(), l.name()))
+            .collect();
+        format!(
+            "{} on {} at {:.0} rpm, severity {} g, noise {} ({:.3} g{}): {record}; monitor flags: {}",
+            self.case.fault.name(),
+            self.case.bearing,
+            self.case.rpm,
+            self.case.severity,
+            self.case.noise.label(),
+            self.noise_g,
+            self.snr_db
+                .map_or(String::new(), |s| format!(", SNR {s:+.1} dB")),
+            flags.join(", ")
+        )
+    }
+
+    pub fn record_predicted(&self) -> Predicted {
+        self.record
+            .as_ref()
+            .map_or(Predicted::None, |outcome| outcome.predicted)
+    }
+}
+
+/// What every case of a sweep shares: the daemon's settings.
+pub struct Bench {
+    pub config: Config,
+}
+
+/// The sensor's scale, g per count: the embedded default's (±16 g in an i16).
+fn scale_g_per_count(config: &Config) -> f64 {
+    config
+        .sensors
+        .first()
+        .map_or(0.000_488, |s| s.scale_g_per_count)
+}
+
+impl Bench {
+    /// The embedded default config: the analysis and flag settings a new user's daemon runs.
+    pub fn embedded() -> Result<Self, String> {
+        let config = Config::default_embedded().map_err(|e| e.to_string())?;
+        Ok(Bench { config })
+    }
+
+    pub fn analysis(&self) -> &AnalysisSettings {
+        &self.config.analysis
+    }
+
+    /// The monitor settings the daemon would derive for a sensor on `machine` at `rpm`.
+    pub fn monitor_settings(&self, machine: &Machine, rpm: f64) -> MonitorSettings {
+        let sensor = SensorConfig {
+            id: "evaluate".into(),
+            transport: Transport::Sim(SimConfig::default()),
+            sample_rate_hz: machine.fs_hz,
+            scale_g_per_count: scale_g_per_count(&self.config),
+            axes: vec!["radial".into()],
+            bearing: machine.bearing.clone(),
+            speed: Speed::Fixed { rpm },
+        };
+        monitor_settings(&self.config, &sensor, 0, 1)
+    }
+}
+
+/// The simulation parameters of a case, noise not yet set.
+fn params_of(case: &Case, machine: &Machine, nuisance: &Nuisance) -> SimulationParams {
+    SimulationParams {
+        fault: case.fault,
+        rpm: case.rpm,
+        bearing: machine.bearing.clone(),
+        fs_hz: machine.fs_hz,
+        amplitude_g: case.severity,
+        resonance_hz: machine.resonance_hz,
+        nuisance: nuisance.clone(),
+        seed: case.seed,
+        ..SimulationParams::example(case.fault)
+    }
+}
+
+/// Seconds of noiseless signal the fault's RMS is measured over.
+const RMS_SECONDS: f64 = 4.0;
+
+/// RMS of the fault's own signal (no noise, no tones, no nuisance), g.
+fn fault_rms_g(params: &SimulationParams) -> f64 {
+    let quiet = SimulationParams {
+        noise_g: 0.0,
+        shaft_tone_g: 0.0,
+        nuisance: Nuisance::none(),
+        ..params.clone()
+    };
+    let samples = Simulator::record(quiet, RMS_SECONDS);
+    let power: f64 =
+        samples.iter().map(|&x| f64::from(x).powi(2)).sum::<f64>() / samples.len().max(1) as f64;
+    power.sqrt()
+}
+
+/// Samples per block fed to the monitor (0.1 s at 12 kHz, like a sensor's frames batched).
+const BLOCK: usize = 1200;
+
+/// Runs one case through both paths.
+pub fn run_case(
+    bench: &Bench,
+    sweep: &Sweep,
+    case: &Case,
+    analyzer: &mut RecordAnalyzer,
+) -> CaseResult {
+    let machine = &sweep.machines[case.machine];
+    let mut params = params_of(case, machine, &sweep.nuisance);
+    let fault_rms = fault_rms_g(&params);
+    // The broadband noise is the white noise and the nuisance's shaft-modulated noise
+    // together: an SNR sets both, in the preset's proportion between them.
+    let modulation_power = 1.0 + 0.5 * params.nuisance.modulation_depth.powi(2);
+    let modulated_per_white = params.nuisance.modulated_noise_g / params.noise_g.max(1e-12);
+    let broadband_per_white = (1.0 + modulated_per_white.powi(2) * modulation_power).sqrt();
+    if let NoiseLevel::Snr(db) = case.noise {
+        let reference = if case.fault == SimulatedFault::None {
+            let outer = Case {
+                fault: SimulatedFault::OuterRace,
+                severity: DEFAULT_SEVERITY,
+                ..case.clone()
+            };
+            fault_rms_g(&params_of(&outer, machine, &Nuisance::none()))
+        } else {
+            fault_rms
+        };
+        let broadband = reference / 10f64.powf(db / 20.0);
+        params.noise_g = broadband / broadband_per_white;
+        params.nuisance.modulated_noise_g = modulated_per_white * params.noise_g;
+    }
+    let broadband_g = params.noise_g * broadband_per_white;
+    let snr_db = (case.fault != SimulatedFault::None && broadband_g > 0.0)
+        .then(|| 20.0 * (fault_rms / broadband_g).log10());
+    let freqs = params.frequencies();
+    let fs = params.fs_hz;
+    let noise_g = broadband_g;
+    let signal = Simulator::record(params, sweep.monitor_s);
+
+    let record_len = ((sweep.record_s * fs).round() as usize).min(signal.len());
+    let record = analyzer
+        .analyze(&signal[..record_len], fs, &freqs, bench.analysis())
+        .map(|analysis| record_outcome(&analysis.diagnosis, &analysis))
+        .map_err(|e| e.to_string());
+
+    let settings = bench.monitor_settings(machine, case.rpm);
+    let scale = scale_g_per_count(&bench.config);
+    let counts: Vec<i16> = signal
+        .iter()
+        .map(|&g| (f64::from(g) / scale).round().clamp(-32768.0, 32767.0) as i16)
+        .collect();
+    let monitor = run_monitor(settings, freqs, &counts, scale);
+
+    CaseResult {
+        case: case.clone(),
+        noise_g,
+        snr_db,
+        record,
+        monitor,
+    }
+}
+
+fn record_outcome(
+    diagnosis: &Diagnosis,
+    analysis: &crate::analysis::RecordAnalysis,
+) -> RecordOutcome {
+    RecordOutcome {
+        verdict: diagnosis.verdict.name().to_string(),
+        predicted: Predicted::of_verdict(diagnosis.verdict),
+        confidence: diagnosis.confidence,
+        reason: diagnosis.reason.clone(),
+        scores: FaultKind::ALL.map(|kind| analysis.score(kind)),
+    }
+}
+
+/// Feeds the counts to a fresh channel monitor block by block and watches its flags.
+fn run_monitor(
+    settings: MonitorSettings,
+    freqs: crate::bearing::FaultFrequencies,
+    counts: &[i16],
+    scale: f64,
+) -> MonitorOutcome {
+    let fs = settings.fs_hz;
+    let mut monitor = ChannelMonitor::new(settings, freqs, None);
+    let mut level = [FlagLevel::Ok; 4];
+    let mut highest = [FlagLevel::Ok; 4];
+    let mut first_flag = None;
+    let mut bands_known = false;
+    let (mut scored, mut flagged) = (0u64, 0u64);
+    for (i, block) in counts.chunks(BLOCK).enumerate() {
+        monitor.push_counts((i * BLOCK) as u64, block, scale, &mut |event| match event {
+            MonitorEvent::Bands { .. } => bands_known = true,
+            MonitorEvent::Flag { fault, change, .. } => {
+                let index = FaultKind::ALL.iter().position(|&k| k == fault).unwrap_or(0);
+                level[index] = change.to;
+                highest[index] = highest[index].max(change.to);
+                if change.to > change.from && first_flag.is_none() {
+                    first_flag = Some(change.at_sample as f64 / fs);
+                }
+            }
+            MonitorEvent::Window(_) if bands_known => {
+                scored += 1;
+                if level.iter().any(|&l| l > FlagLevel::Ok) {
+                    flagged += 1;
+                }
+            }
+            _ => {}
+        });
+    }
+    let raised: Vec<FaultKind> = FaultKind::ALL
+        .into_iter()
+        .zip(highest)
+        .filter(|(_, l)| *l > FlagLevel::Ok)
+        .map(|(k, _)| k)
+        .collect();
+    let predicted = match raised.as_slice() {
+        [] => Predicted::None,
+        [one] => Predicted::Fault(*one),
+        _ => Predicted::Several,
+    };
+    MonitorOutcome {
+        highest,
+        first_flag_s: first_flag,
+        windows_scored: scored,
+        windows_flagged: flagged,
+        predicted,
+    }
+}
