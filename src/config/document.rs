@@ -6,6 +6,9 @@
 //! removed from the tree, and the raw form is read again. Each round removes one entry, so the
 //! loop ends. Syntax errors are reported (all that toml's recovering parser finds) and end the
 //! reading: a half-understood file is not validated further.
+//!
+//! Not `serde_ignored`: it gives an ignored key's path but not its table's known keys, which
+//! every unknown-key message lists (and the nearest of them, by strsim); serde's error has both.
 
 use std::ops::Range;
 
