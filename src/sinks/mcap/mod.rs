@@ -28,7 +28,7 @@ pub struct McapSink {
     rates: HashMap<String, f64>,
     next_flush_ns: u64,
     last_ns: u64,
-    errors: Vec<String>,
+    errors: Vec<McapLogError>,
     pub messages: u64,
 }
 
@@ -101,13 +101,13 @@ impl Sink for McapSink {
         };
         match logger.log(message, time, time) {
             Ok(_) => self.messages += 1,
-            Err(e) if self.errors.len() < 10 => self.errors.push(e.to_string()),
+            Err(e) if self.errors.len() < 10 => self.errors.push(e),
             Err(_) => {}
         }
         if self.last_ns >= self.next_flush_ns {
             self.next_flush_ns = self.last_ns + FLUSH_EVERY_NS;
             if let Err(e) = logger.flush() {
-                self.errors.push(e.to_string());
+                self.errors.push(e);
             }
         }
     }
@@ -115,14 +115,16 @@ impl Sink for McapSink {
     fn finish(&mut self) -> Result<(), SinkError> {
         let finished = self.logger.take().map(|l| l.finish());
         if let Some(Err(e)) = finished {
-            self.errors.push(e.to_string());
+            self.errors.push(e);
         }
-        match self.errors.first() {
+        let count = self.errors.len();
+        let mut errors = std::mem::take(&mut self.errors).into_iter();
+        match errors.next() {
             None => Ok(()),
             Some(first) => Err(SinkError {
                 sink: "MCAP log",
-                count: self.errors.len(),
-                first: first.clone(),
+                count,
+                first: Box::new(first),
             }),
         }
     }
