@@ -8,7 +8,7 @@
 //! produces the signal block by block (so a sensor can stream it for months) and is
 //! deterministic for a given seed.
 
-use super::rng::Rng;
+use crate::random::Rng;
 use crate::bearing::{BearingGeometry, FaultFrequencies, Race};
 use crate::messages::FaultKind;
 use serde::Serialize;
