@@ -275,9 +275,7 @@ fn spawn<T: Send + 'static>(
 
 /// Waits for a thread of the daemon; its panic becomes an error.
 fn join<T>(what: &'static str, thread: std::thread::JoinHandle<T>) -> Result<T, RunError> {
-    thread
-        .join()
-        .map_err(|_| RunError::ThreadPanicked { what })
+    thread.join().map_err(|_| RunError::ThreadPanicked { what })
 }
 
 /// What the analysis thread reports when it ends.
