@@ -35,6 +35,8 @@
 //! - [`messages`]: the vocabulary every room above speaks: typed faults, flags, health stages,
 //!   speed sources and the pipeline's messages; MCAP and iceoryx2 encode them at the edge.
 //! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies.
+//! - [`random`]: seeded random numbers (ChaCha8), the same on every machine, for the simulator
+//!   and for tests at every level.
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
 
@@ -50,6 +52,7 @@ pub mod messages;
 pub mod offline;
 pub mod pipeline;
 pub mod plot;
+pub mod random;
 pub mod recording;
 pub mod report;
 pub mod sinks;

@@ -16,6 +16,7 @@
 //! anywhere).
 
 use crate::bearing::FaultFrequencies;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -31,7 +32,9 @@ macro_rules! display_as_name {
 }
 
 /// The fault classes that have a characteristic frequency.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum FaultKind {
     OuterRace,
@@ -94,7 +97,9 @@ impl FaultKind {
 }
 
 /// A fault flag's level: `ok | watch | alarm`, ordered by severity.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum FlagLevel {
     Ok,
@@ -116,7 +121,9 @@ impl FlagLevel {
 }
 
 /// The bearing's stage of life (MODELS.md §7).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum HealthStage {
     /// Learning the healthy baseline.
@@ -141,7 +148,9 @@ impl HealthStage {
 }
 
 /// What a [`HealthMessage`] reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum HealthKind {
     /// The source has not heard the sensor within its timeout.
@@ -180,7 +189,9 @@ impl HealthKind {
 }
 
 /// Where a channel's shaft speed comes from (config `sensors[].speed.source`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum SpeedSource {
     /// A fixed speed from the config.
@@ -205,7 +216,9 @@ impl SpeedSource {
 display_as_name!(FaultKind, FlagLevel, HealthStage, HealthKind, SpeedSource);
 
 /// Identifies one analysed signal: a sensor (node) and one of its axes.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
 pub struct ChannelId {
     /// The sensor's id from the config (e.g. `motor-de`).
     pub sensor: String,
@@ -233,7 +246,7 @@ pub struct RawBlock {
 }
 
 /// The averaged squared-envelope spectrum, at a low rate. Topic `/spectrum/<sensor>/<axis>`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct SpectrumMessage {
     pub channel: ChannelId,
     pub end_sample: u64,
@@ -245,7 +258,7 @@ pub struct SpectrumMessage {
 }
 
 /// Indicators and fault scores of the newest window. Topic `/indicators/<sensor>/<axis>`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct IndicatorsMessage {
     pub channel: ChannelId,
     pub end_sample: u64,
@@ -262,7 +275,7 @@ pub struct IndicatorsMessage {
 }
 
 /// The twin's latest fit. Topic `/twin/<sensor>/<axis>`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct TwinMessage {
     pub channel: ChannelId,
     pub end_sample: u64,
@@ -286,7 +299,7 @@ pub struct TwinMessage {
 }
 
 /// A fault flag changed state. Topic `/flags/<sensor>/<axis>`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct FlagMessage {
     pub channel: ChannelId,
     pub end_sample: u64,
@@ -298,7 +311,7 @@ pub struct FlagMessage {
 }
 
 /// Something about the sensor or the bearing's life changed. Topic `/health/<sensor>/<axis>`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct HealthMessage {
     pub channel: ChannelId,
     pub end_sample: u64,
@@ -311,7 +324,7 @@ pub struct HealthMessage {
 /// The shaft speed a channel uses from `end_sample` on (every speed frame, every estimate).
 /// Topic `/speed/<sensor>/<axis>`. A replay feeds the measured ones (`source = "can"`) back at
 /// their samples, so its flags equal the live run's.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct SpeedMessage {
     pub channel: ChannelId,
     /// The sample from which the speed applies.
@@ -328,7 +341,7 @@ pub struct SpeedMessage {
 /// Counters of one source since the daemon started, every `outputs.status_interval_s` and
 /// when the source stops. Topic `/ingest/<source>`, `<source>` `can-<interface>` or
 /// `shm-<sensor>`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct IngestMessage {
     pub source: String,
     /// Frames received, valid or not.

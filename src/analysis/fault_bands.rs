@@ -586,29 +586,7 @@ fn median_in_place(values: &mut [f32]) -> f32 {
 mod tests {
     use super::*;
     use crate::bearing::BearingGeometry;
-
-    /// A small seeded normal source for the tests (SplitMix64 + Box–Muller; the twin's own
-    /// sits above this module in the layout).
-    struct Rng(u64);
-
-    impl Rng {
-        fn new(seed: u64) -> Self {
-            Rng(seed)
-        }
-
-        fn uniform(&mut self) -> f64 {
-            self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-            let mut z = self.0;
-            z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-            ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-        }
-
-        fn normal(&mut self) -> f64 {
-            let u = self.uniform().max(1e-300);
-            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * self.uniform()).cos()
-        }
-    }
+    use crate::random::Rng;
 
     const BIN_HZ: f64 = 12_000.0 / 4096.0;
 

@@ -6,6 +6,9 @@
 //! removed from the tree, and the raw form is read again. Each round removes one entry, so the
 //! loop ends. Syntax errors are reported (all that toml's recovering parser finds) and end the
 //! reading: a half-understood file is not validated further.
+//!
+//! Not `serde_ignored`: it gives an ignored key's path but not its table's known keys, which
+//! every unknown-key message lists (and the nearest of them, by strsim); serde's error has both.
 
 use std::ops::Range;
 
@@ -227,11 +230,13 @@ fn parse_unknown_field(message: &str) -> Option<(String, Vec<String>)> {
     Some((unknown, quoted.collect()))
 }
 
-/// The known key nearest to a misspelt one, if it is near enough to be a likely typo.
+/// The known key nearest to a misspelt one, if it is near enough to be a likely typo. The
+/// distance is strsim's optimal string alignment: a swap of two neighbours is one edit, so that
+/// `fualt` is one edit from `fault`.
 fn closest<'a>(unknown: &str, known: &'a [String]) -> Option<&'a str> {
     known
         .iter()
-        .map(|k| (edit_distance(unknown, k), k))
+        .map(|k| (strsim::osa_distance(unknown, k), k))
         .filter(|(distance, k)| *distance <= (k.chars().count() / 3).max(1))
         .min_by_key(|(distance, _)| *distance)
         .map(|(_, k)| k.as_str())
@@ -251,34 +256,6 @@ fn closest<'a>(unknown: &str, known: &'a [String]) -> Option<&'a str> {
                 _ => None,
             }
         })
-}
-
-/// Edit distance by characters, counting a swap of two neighbours as one edit (optimal string
-/// alignment), so that `fualt` is one edit from `fault`.
-fn edit_distance(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.chars().collect();
-    let b: Vec<char> = b.chars().collect();
-    // rows[i][j]: distance between a[..i] and b[..j].
-    let mut rows = vec![vec![0usize; b.len() + 1]; a.len() + 1];
-    for (i, row) in rows.iter_mut().enumerate() {
-        row[0] = i;
-    }
-    for (j, cell) in rows[0].iter_mut().enumerate() {
-        *cell = j;
-    }
-    for i in 1..=a.len() {
-        for j in 1..=b.len() {
-            let cost = usize::from(a[i - 1] != b[j - 1]);
-            let mut best = (rows[i - 1][j] + 1)
-                .min(rows[i][j - 1] + 1)
-                .min(rows[i - 1][j - 1] + cost);
-            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                best = best.min(rows[i - 2][j - 2] + 1);
-            }
-            rows[i][j] = best;
-        }
-    }
-    rows[a.len()][b.len()]
 }
 
 /// `line L, column C` of a byte offset (1-based; columns count characters).

@@ -82,8 +82,14 @@ pub enum RunError {
     #[cfg(feature = "shm")]
     #[error("alerts: {0}")]
     Alerts(#[from] crate::sinks::alerts::AlertError),
-    #[error("{what} thread failed: {detail}")]
-    Thread { what: &'static str, detail: String },
+    #[error("cannot start the {what} thread: {source}")]
+    ThreadSpawn {
+        what: &'static str,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("the {what} thread panicked (its message is in the log above)")]
+    ThreadPanicked { what: &'static str },
     #[error("sink thread failed: {0}")]
     Sink(#[from] SinkError),
 }
@@ -306,18 +312,12 @@ fn spawn<T: Send + 'static>(
     std::thread::Builder::new()
         .name(format!("bearingd-{what}"))
         .spawn(body)
-        .map_err(|e| RunError::Thread {
-            what,
-            detail: e.to_string(),
-        })
+        .map_err(|source| RunError::ThreadSpawn { what, source })
 }
 
 /// Waits for a thread of the daemon; its panic becomes an error.
 fn join<T>(what: &'static str, thread: std::thread::JoinHandle<T>) -> Result<T, RunError> {
-    thread.join().map_err(|_| RunError::Thread {
-        what,
-        detail: "panicked".into(),
-    })
+    thread.join().map_err(|_| RunError::ThreadPanicked { what })
 }
 
 /// What the analysis thread reports when it ends.

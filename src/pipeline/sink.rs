@@ -12,12 +12,14 @@ pub trait Sink: Send {
     fn finish(&mut self) -> Result<(), SinkError>;
 }
 
-/// What went wrong in a sink over its life, reported when it finishes.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+/// What went wrong in a sink over its life, reported when it finishes: the first error as the
+/// sink's own type (the cause chain stays intact), and how many there were.
+#[derive(Debug, thiserror::Error)]
 #[error("{sink}: {count} error(s), the first: {first}")]
 pub struct SinkError {
     /// Which sink (`MCAP log`).
     pub sink: &'static str,
     pub count: usize,
-    pub first: String,
+    #[source]
+    pub first: Box<dyn std::error::Error + Send + Sync + 'static>,
 }

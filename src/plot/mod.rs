@@ -11,6 +11,10 @@
 //! PNG comes from a built-in public-domain 8×8 bitmap font, so rendering works on a headless
 //! edge box with no fonts, no fontconfig and no display.
 //!
+//! Ours stays, not `plotters`: its PNG text needs system fonts (font-kit) or a font file, and
+//! its SVG backend would replace only `svg.rs`; the layout (bands, fault markers, kurtogram) is
+//! ours either way, and one scene gives both formats the same picture.
+//!
 //! ```no_run
 //! use bearingd::plot::{self, Color, Figure, Marker, Series, SpectrumPanel};
 //! # fn main() -> Result<(), plot::PlotError> {

@@ -5,6 +5,10 @@
 //! its line number. A last line without a final newline that does not parse is the mark of a
 //! file cut mid-row (a copy interrupted, a logger killed): it is dropped with a warning and the
 //! rows before it are kept.
+//!
+//! Ours stays, not the `csv` crate: one reader serves `,`/`;`/tab tables and the
+//! whitespace-aligned IMS files alike (csv covers only the delimited ones and would sit beside
+//! it), numeric tables need no quoted separators, and the cut-last-row rule needs line ends.
 
 use super::RecordingError;
 use std::path::Path;

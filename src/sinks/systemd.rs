@@ -1,10 +1,9 @@
 //! systemd's notify protocol (`sd_notify`), written by hand: `READY=1`, `STATUS=…`,
 //! `WATCHDOG=1`, `STOPPING=1`.
 //!
-//! Why by hand: the protocol is one datagram of `KEY=VALUE` lines sent to the socket named by
-//! `$NOTIFY_SOCKET` (a path, or an abstract socket written `@name`). Linking libsystemd (or a
-//! crate around it) would add a C dependency to a daemon that also runs without systemd, for
-//! twenty lines of code.
+//! Ours stays, not the `sd-notify` crate (0.5): it reads `$NOTIFY_SOCKET` only from the
+//! environment (tests would have to mutate it), cannot reach abstract `@name` sockets, and sends
+//! blocking on a new socket per call; the protocol is one non-blocking datagram, a few lines here.
 //!
 //! Rules kept here:
 //! - Without `$NOTIFY_SOCKET` every call is a no-op, so `bearingd run` in a terminal, in tests

@@ -7,11 +7,15 @@
 //! the loss also shows as exact gaps), `Block` for tests and replay, where the producer waits
 //! and pushes back into the transport instead.
 //!
-//! Synchronisation: one `Mutex` around the deque (held for a push or a pop only); a `Condvar`
-//! wakes a producer waiting for room; a tokio `Notify` wakes the async consumer.
+//! Storage: crossbeam's lock-free `ArrayQueue` (fixed capacity, allocated once); its
+//! `force_push` hands back the oldest item, which `DropOldest` counts. A producer that must
+//! `Block` waits on a `Condvar` that the consumer signals after each pop; a tokio `Notify` wakes
+//! the async consumer.
 
-use std::collections::VecDeque;
+use crossbeam_queue::ArrayQueue;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
+use std::time::Duration;
 use tokio::sync::Notify;
 
 /// What a push does when the queue is full.
@@ -24,19 +28,27 @@ pub enum WhenFull {
 }
 
 #[derive(Debug)]
-struct State<T> {
-    items: VecDeque<T>,
-    dropped: u64,
-    closed: bool,
-}
-
-#[derive(Debug)]
 struct Shared<T> {
-    state: Mutex<State<T>>,
+    items: ArrayQueue<T>,
+    /// Items dropped since the consumer last looked.
+    dropped: AtomicU64,
+    /// Either end is gone.
+    closed: AtomicBool,
+    /// A blocked producer waits here for room (the mutex guards nothing but the wait).
+    room_lock: Mutex<()>,
     room: Condvar,
     ready: Notify,
-    capacity: usize,
     when_full: WhenFull,
+}
+
+impl<T> Shared<T> {
+    fn close(&self) {
+        self.closed.store(true, Ordering::Release);
+        // Taking the lock orders this with a producer between its check and its wait.
+        drop(self.room_lock.lock());
+        self.room.notify_all();
+        self.ready.notify_one();
+    }
 }
 
 /// The producing end (blocking).
@@ -54,14 +66,12 @@ pub struct Consumer<T> {
 /// A queue of at most `capacity` (≥ 1) items.
 pub fn bounded<T>(capacity: usize, when_full: WhenFull) -> (Producer<T>, Consumer<T>) {
     let shared = Arc::new(Shared {
-        state: Mutex::new(State {
-            items: VecDeque::with_capacity(capacity.max(1)),
-            dropped: 0,
-            closed: false,
-        }),
+        items: ArrayQueue::new(capacity.max(1)),
+        dropped: AtomicU64::new(0),
+        closed: AtomicBool::new(false),
+        room_lock: Mutex::new(()),
         room: Condvar::new(),
         ready: Notify::new(),
-        capacity: capacity.max(1),
         when_full,
     });
     (
@@ -76,30 +86,39 @@ impl<T> Producer<T> {
     /// Pushes `item` by the queue's policy. Returns `false` if the consumer is gone.
     pub fn push(&self, item: T) -> bool {
         let shared = &*self.shared;
-        let Ok(mut state) = shared.state.lock() else {
+        if shared.closed.load(Ordering::Acquire) {
             return false;
-        };
-        loop {
-            if state.closed {
-                return false;
-            }
-            if state.items.len() < shared.capacity {
-                break;
-            }
-            match shared.when_full {
-                WhenFull::DropOldest => {
-                    state.items.pop_front();
-                    state.dropped += 1;
-                    break;
+        }
+        match shared.when_full {
+            WhenFull::DropOldest => {
+                if shared.items.force_push(item).is_some() {
+                    shared.dropped.fetch_add(1, Ordering::Relaxed);
                 }
-                WhenFull::Block => match shared.room.wait(state) {
-                    Ok(guard) => state = guard,
-                    Err(_) => return false,
-                },
+            }
+            WhenFull::Block => {
+                let mut item = item;
+                while let Err(back) = shared.items.push(item) {
+                    item = back;
+                    let Ok(guard) = shared.room_lock.lock() else {
+                        return false;
+                    };
+                    if shared.closed.load(Ordering::Acquire) {
+                        return false;
+                    }
+                    if shared.items.is_full() {
+                        // The consumer signals under the lock after a pop; the timeout is only
+                        // a second guard.
+                        if shared
+                            .room
+                            .wait_timeout(guard, Duration::from_millis(50))
+                            .is_err()
+                        {
+                            return false;
+                        }
+                    }
+                }
             }
         }
-        state.items.push_back(item);
-        drop(state);
         shared.ready.notify_one();
         true
     }
@@ -117,10 +136,7 @@ impl<T> Producer<T> {
 
 impl<T> Drop for Producer<T> {
     fn drop(&mut self) {
-        if let Ok(mut state) = self.shared.state.lock() {
-            state.closed = true;
-        }
-        self.shared.ready.notify_one();
+        self.shared.close();
     }
 }
 
@@ -128,21 +144,23 @@ impl<T> Consumer<T> {
     /// The next item and the number of items dropped since the previous call; `None` once the
     /// producer is gone and the queue is empty.
     pub async fn pop(&self) -> Option<(T, u64)> {
+        let shared = &*self.shared;
         loop {
             // Register interest before checking, so a push between the check and the await
             // is not missed.
-            let notified = self.shared.ready.notified();
-            {
-                let mut state = self.shared.state.lock().ok()?;
-                if let Some(item) = state.items.pop_front() {
-                    let dropped = std::mem::take(&mut state.dropped);
-                    drop(state);
-                    self.shared.room.notify_one();
-                    return Some((item, dropped));
+            let notified = shared.ready.notified();
+            // Read `closed` before popping: an item pushed before the close is still taken.
+            let closed = shared.closed.load(Ordering::Acquire);
+            if let Some(item) = shared.items.pop() {
+                let dropped = shared.dropped.swap(0, Ordering::Relaxed);
+                if shared.when_full == WhenFull::Block {
+                    drop(shared.room_lock.lock());
+                    shared.room.notify_one();
                 }
-                if state.closed {
-                    return None;
-                }
+                return Some((item, dropped));
+            }
+            if closed {
+                return None;
             }
             notified.await;
         }
@@ -151,10 +169,7 @@ impl<T> Consumer<T> {
 
 impl<T> Drop for Consumer<T> {
     fn drop(&mut self) {
-        if let Ok(mut state) = self.shared.state.lock() {
-            state.closed = true;
-        }
-        self.shared.room.notify_all();
+        self.shared.close();
     }
 }
 

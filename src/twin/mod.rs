@@ -6,7 +6,6 @@ pub mod diagnose;
 pub mod fit;
 pub mod model;
 pub mod optimize;
-pub mod rng;
 pub mod simulate;
 
 pub use fit::{FitBounds, HypothesisFit, TwinFitter, TwinParams};

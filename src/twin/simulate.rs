@@ -20,9 +20,9 @@
 //! produces the signal block by block (so a sensor can stream it for months) and is
 //! deterministic for a given seed.
 
-use super::rng::Rng;
 use crate::bearing::{BearingGeometry, FaultFrequencies, Race};
 use crate::messages::FaultKind;
+use crate::random::Rng;
 use serde::Serialize;
 
 /// Which defect the simulated bearing has.

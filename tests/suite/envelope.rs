@@ -5,7 +5,7 @@ use bearingd::analysis::envelope::{
     welch_envelope_spectrum, BandEnvelope, FftPlans, RollingEnvelope, WindowTransform,
 };
 use bearingd::analysis::Band;
-use bearingd::twin::rng::Rng;
+use bearingd::random::Rng;
 use std::f64::consts::TAU;
 
 /// Amplitude-modulated resonance: carrier `carrier_hz`, modulation `mod_hz`, plus noise.

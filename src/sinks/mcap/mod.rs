@@ -32,7 +32,7 @@ pub struct McapSink {
     rates: HashMap<String, f64>,
     next_flush_ns: u64,
     last_ns: u64,
-    errors: Vec<String>,
+    errors: Vec<McapLogError>,
     pub messages: u64,
     /// Told of every retention pass that deleted files (the operator must know).
     on_retention: Box<dyn Fn(&RetentionReport) + Send>,
@@ -134,13 +134,13 @@ impl Sink for McapSink {
                     (self.on_retention)(&report);
                 }
             }
-            Err(e) if self.errors.len() < 10 => self.errors.push(e.to_string()),
+            Err(e) if self.errors.len() < 10 => self.errors.push(e),
             Err(_) => {}
         }
         if self.last_ns >= self.next_flush_ns {
             self.next_flush_ns = self.last_ns + FLUSH_EVERY_NS;
             if let Err(e) = logger.flush() {
-                self.errors.push(e.to_string());
+                self.errors.push(e);
             }
         }
     }
@@ -148,14 +148,16 @@ impl Sink for McapSink {
     fn finish(&mut self) -> Result<(), SinkError> {
         let finished = self.logger.take().map(|l| l.finish());
         if let Some(Err(e)) = finished {
-            self.errors.push(e.to_string());
+            self.errors.push(e);
         }
-        match self.errors.first() {
+        let count = self.errors.len();
+        let mut errors = std::mem::take(&mut self.errors).into_iter();
+        match errors.next() {
             None => Ok(()),
             Some(first) => Err(SinkError {
                 sink: "MCAP log",
-                count: self.errors.len(),
-                first: first.clone(),
+                count,
+                first: Box::new(first),
             }),
         }
     }

@@ -1,33 +1,33 @@
-//! A small deterministic random source (SplitMix64 + Box–Muller) so that a simulation is the
-//! same for the same seed on every machine and in every release: tests, the firmware
-//! simulator and the embedded default rely on that.
+//! Seeded random numbers, the same for the same seed on every machine, for the simulator and
+//! for tests at every level (it sits at the bottom of the layout so that `analysis` tests can use
+//! it too): rand_chacha's ChaCha8, whose output for a seed is fixed by its documented algorithm,
+//! plus normal draws by Box–Muller.
 
-/// SplitMix64: tiny, fast, statistically good enough for noise and jitter.
+use rand::{Rng as _, RngCore as _, SeedableRng as _};
+use rand_chacha::ChaCha8Rng;
+
+/// A seeded stream of uniform and normal numbers.
 #[derive(Debug, Clone)]
 pub struct Rng {
-    state: u64,
+    inner: ChaCha8Rng,
     spare_normal: Option<f64>,
 }
 
 impl Rng {
     pub fn new(seed: u64) -> Self {
         Rng {
-            state: seed ^ 0x9E37_79B9_7F4A_7C15,
+            inner: ChaCha8Rng::seed_from_u64(seed),
             spare_normal: None,
         }
     }
 
     pub fn next_u64(&mut self) -> u64 {
-        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.inner.next_u64()
     }
 
-    /// Uniform in (0, 1].
+    /// Uniform in (0, 1] (never 0, so that its logarithm is finite).
     pub fn uniform(&mut self) -> f64 {
-        ((self.next_u64() >> 11) as f64 + 1.0) / (1u64 << 53) as f64
+        1.0 - self.inner.random::<f64>()
     }
 
     /// Standard normal.
