@@ -127,10 +127,7 @@ impl<T> Producer<T> {
 impl<T> Producer<T> {
     /// Whether a push now would find the queue full.
     pub fn is_full(&self) -> bool {
-        self.shared
-            .state
-            .lock()
-            .map_or(true, |state| state.items.len() >= self.shared.capacity)
+        self.shared.items.is_full()
     }
 }
 
