@@ -18,6 +18,8 @@
 //! - [`twin`]: the signal-model twin of a defective bearing (simulation now, fitting later).
 //! - [`ingest`]: sources (SocketCAN, iceoryx2) that turn sensor frames into sample blocks in
 //!   sample time, counting gaps, restarts, silent sensors and malformed frames.
+//! - [`sinks`]: where results leave the box: the fleet bridge (MQTT Sparkplug B with
+//!   store-and-forward).
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
@@ -34,4 +36,5 @@ pub mod offline;
 pub mod plot;
 pub mod recording;
 pub mod report;
+pub mod sinks;
 pub mod twin;

@@ -48,6 +48,7 @@
 
 mod document;
 mod error;
+mod fleet;
 mod raw;
 mod types;
 mod validate;
@@ -55,6 +56,7 @@ mod validate;
 use std::path::Path;
 
 pub use error::{ConfigError, ConfigProblem};
+pub use fleet::{Broker, FleetConfig};
 pub use types::{
     CanConfig, Config, OutputConfig, SensorConfig, ShmConfig, SimConfig, SimFault, Speed,
     ThresholdConfig, Transport, TwinConfig,

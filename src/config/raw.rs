@@ -61,6 +61,7 @@ pub(crate) struct RawConfig {
     pub twin: RawTwin,
     pub thresholds: RawThresholds,
     pub outputs: RawOutputs,
+    pub fleet: super::fleet::RawFleet,
 }
 
 #[derive(Debug, Default, Deserialize)]

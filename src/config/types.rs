@@ -24,6 +24,8 @@ pub struct Config {
     pub thresholds: ThresholdConfig,
     /// Where results go (`[outputs]`).
     pub outputs: OutputConfig,
+    /// The fleet bridge over MQTT (`[fleet]`); `None` when it is off (the default).
+    pub fleet: Option<super::fleet::FleetConfig>,
 }
 
 /// One accelerometer (`[[sensors]]`).

@@ -42,15 +42,17 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
     let twin = check.twin(&raw.twin);
     let thresholds = check.thresholds(&raw.thresholds);
     let outputs = check.outputs(&raw.outputs, &sensors);
+    let fleet = check.fleet(&raw.fleet, outputs.as_ref().map(|o| o.state_dir.as_path()));
 
     let sensors: Option<Vec<SensorConfig>> = sensors.into_iter().map(|s| s.config).collect();
-    match (sensors, analysis, twin, thresholds, outputs) {
+    match (sensors, analysis, twin, thresholds, outputs, fleet) {
         (
             Some(sensors),
             Some((analysis, band_period_s)),
             Some(twin),
             Some(thresholds),
             Some(outputs),
+            Some(fleet),
         ) if check.problems.is_empty() => Ok(Config {
             sensors,
             analysis,
@@ -58,6 +60,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
             twin,
             thresholds,
             outputs,
+            fleet,
         }),
         _ => {
             if check.problems.is_empty() {
@@ -75,7 +78,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
 }
 
 /// Types a key may be expected to hold, named for messages.
-trait Expected: Clone {
+pub(super) trait Expected: Clone {
     const WHAT: &'static str;
 }
 impl Expected for f64 {
@@ -98,7 +101,7 @@ impl Expected for Vec<f64> {
 }
 
 /// What a key held.
-enum Got<T> {
+pub(super) enum Got<T> {
     Missing,
     /// Wrong type; already reported.
     Invalid,
@@ -107,7 +110,7 @@ enum Got<T> {
 
 /// The allowed range of a number; `lo`/`hi` may be infinite.
 #[derive(Clone, Copy)]
-struct Limits {
+pub(super) struct Limits {
     lo: f64,
     lo_open: bool,
     hi: f64,
@@ -116,7 +119,7 @@ struct Limits {
 
 impl Limits {
     /// `(lo, hi]`
-    const fn above_to(lo: f64, hi: f64) -> Self {
+    pub(super) const fn above_to(lo: f64, hi: f64) -> Self {
         Limits {
             lo,
             lo_open: true,
@@ -125,7 +128,7 @@ impl Limits {
         }
     }
     /// `[lo, hi]`
-    const fn within(lo: f64, hi: f64) -> Self {
+    pub(super) const fn within(lo: f64, hi: f64) -> Self {
         Limits {
             lo,
             lo_open: false,
@@ -134,7 +137,7 @@ impl Limits {
         }
     }
     /// `(lo, hi)`
-    const fn between(lo: f64, hi: f64) -> Self {
+    pub(super) const fn between(lo: f64, hi: f64) -> Self {
         Limits {
             lo,
             lo_open: true,
@@ -211,16 +214,16 @@ impl CheckedSensor {
 }
 
 #[derive(Default)]
-struct Checker {
+pub(super) struct Checker {
     problems: Vec<ConfigProblem>,
 }
 
 impl Checker {
-    fn problem(&mut self, key: impl Into<String>, message: impl Into<String>) {
+    pub(super) fn problem(&mut self, key: impl Into<String>, message: impl Into<String>) {
         self.problems.push(ConfigProblem::new(key, message));
     }
 
-    fn get<T: Expected>(&mut self, key: &str, field: &Field<T>, fix: &str) -> Got<T> {
+    pub(super) fn get<T: Expected>(&mut self, key: &str, field: &Field<T>, fix: &str) -> Got<T> {
         match field {
             None => Got::Missing,
             Some(Loose::Value(v)) => Got::Value(v.clone()),
@@ -232,7 +235,7 @@ impl Checker {
     }
 
     /// The value, or the default when absent; `None` when it has the wrong type.
-    fn or_default<T: Expected>(
+    pub(super) fn or_default<T: Expected>(
         &mut self,
         key: &str,
         field: &Field<T>,
@@ -265,7 +268,13 @@ impl Checker {
     }
 
     /// Checks a number against its limits (NaN and infinities never pass).
-    fn in_limits(&mut self, key: &str, value: f64, limits: Limits, fix: &str) -> Option<f64> {
+    pub(super) fn in_limits(
+        &mut self,
+        key: &str,
+        value: f64,
+        limits: Limits,
+        fix: &str,
+    ) -> Option<f64> {
         if !value.is_finite() {
             self.problem(key, format!("{value} is not a finite number; {fix}"));
             None
@@ -284,7 +293,7 @@ impl Checker {
     }
 
     /// A number with a default.
-    fn number(
+    pub(super) fn number(
         &mut self,
         key: &str,
         field: &Field<f64>,

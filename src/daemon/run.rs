@@ -63,6 +63,8 @@ pub enum RunError {
     Log(String),
     #[error("alerts: {0}")]
     Alerts(String),
+    #[error("{0}")]
+    Fleet(String),
     #[error("{what} thread failed: {detail}")]
     Thread { what: &'static str, detail: String },
 }
@@ -118,7 +120,9 @@ pub async fn run(
         .iter()
         .map(|s| (s.id.clone(), s.sample_rate_hz))
         .collect();
-    let (mcap, recovered) = McapSink::open(logger_config(&config), rates, wall_clock_now_ns())
+    // Wall time of sample 0: the log's time base, and the fleet bridge's.
+    let origin_ns = wall_clock_now_ns();
+    let (mcap, recovered) = McapSink::open(logger_config(&config), rates, origin_ns)
         .map_err(|e| RunError::Log(e.to_string()))?;
     for report in &recovered {
         eprintln!(
@@ -137,6 +141,11 @@ pub async fn run(
         eprintln!("bearingd: logging to {}", path.display());
     }
     sinks.push(Box::new(mcap));
+    if let Some(fleet) = crate::sinks::fleet::FleetSink::start(&config, origin_ns)
+        .map_err(|e| RunError::Fleet(e.to_string()))?
+    {
+        sinks.push(Box::new(fleet));
+    }
     let baselines = load_baselines(&state_dir);
     let pipeline = Pipeline::new(&config, &baselines);
     let status_board = Arc::new(Mutex::new(pipeline.status()));
