@@ -25,6 +25,11 @@ pub struct RunArgs {
     /// No status lines (flags and the summary are still printed).
     #[arg(long)]
     quiet: bool,
+    /// Also publish to this MQTT broker (mqtt://HOST:PORT or mqtts://HOST:PORT) with the fleet
+    /// bridge's defaults, node id = this host's name: a first look; a service sets [fleet] in
+    /// its config (docs/FLEET.md).
+    #[arg(long, value_name = "BROKER")]
+    fleet: Option<String>,
 }
 
 /// Prints every flag change as it happens.
@@ -58,10 +63,16 @@ impl Sink for FlagPrinter {
 }
 
 pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
-    let config = match &args.config {
+    let mut config = match &args.config {
         Some(path) => config::load(path).map_err(CliError::input)?,
         None => embedded_default(args)?,
     };
+    if let Some(broker) = &args.fleet {
+        let fleet =
+            config::FleetConfig::for_broker(broker, &host_node_id(), &config.outputs.state_dir)
+                .map_err(CliError::input)?;
+        config.fleet = Some(fleet);
+    }
     let options = RunOptions {
         duration_s: args.duration,
         realtime: !args.fast,
@@ -143,4 +154,27 @@ fn data_dir(given: Option<&Path>) -> PathBuf {
 pub(super) fn embedded_config(data_dir_arg: Option<&Path>) -> Result<Config, CliError> {
     let data = data_dir(data_dir_arg);
     Config::embedded_in(&data).map_err(CliError::input)
+}
+
+/// This host's name as a Sparkplug node id (characters outside `A-Z a-z 0-9 - _ .` become
+/// `-`); `bearingd` when it has none.
+fn host_node_id() -> String {
+    let name = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap_or_default();
+    let id: String = name
+        .trim()
+        .chars()
+        .take(64)
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    if id.is_empty() {
+        "bearingd".into()
+    } else {
+        id
+    }
 }

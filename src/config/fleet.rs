@@ -81,6 +81,33 @@ impl FleetConfig {
     }
 }
 
+impl FleetConfig {
+    /// The bridge with its defaults for `broker` (`mqtt://…` or `mqtts://…`), node id
+    /// `node_id` and the queue under `state_dir`: `bearingd run --fleet BROKER`, a first look
+    /// without writing a config. Problems are those `[fleet]` would report for the same keys.
+    pub fn for_broker(
+        broker: &str,
+        node_id: &str,
+        state_dir: &Path,
+    ) -> Result<FleetConfig, super::ConfigError> {
+        use super::raw::Loose;
+        let raw = RawFleet {
+            enabled: Some(Loose::Value(true)),
+            broker: Some(Loose::Value(broker.to_string())),
+            node_id: Some(Loose::Value(node_id.to_string())),
+            ..RawFleet::default()
+        };
+        let mut check = Checker::default();
+        match check.fleet(&raw, Some(state_dir)) {
+            Some(Some(config)) if check.problems.is_empty() => Ok(config),
+            _ => Err(super::ConfigError {
+                file: "--fleet".into(),
+                problems: check.problems,
+            }),
+        }
+    }
+}
+
 pub(crate) const DEFAULT_BROKER: &str = "mqtt://localhost:1883";
 const DEFAULT_GROUP: &str = "bearingd";
 const DEFAULT_PERIOD_S: f64 = 1.0;

@@ -215,7 +215,7 @@ impl CheckedSensor {
 
 #[derive(Default)]
 pub(super) struct Checker {
-    problems: Vec<ConfigProblem>,
+    pub(super) problems: Vec<ConfigProblem>,
 }
 
 impl Checker {

@@ -6,6 +6,7 @@ mod cli;
 mod daemon;
 mod developer_set;
 mod envelope;
+mod fleet;
 mod kinematics;
 mod monitor;
 mod speed;

@@ -388,11 +388,16 @@ impl Bridge {
         }
     }
 
-    /// Nothing left to send, nothing awaiting an acknowledgement (or no session to send on).
+    /// Nothing left to send, nothing awaiting an acknowledgement, or no session to send on. A
+    /// session still connecting is waited for (within the stop's grace), so that a short run
+    /// delivers what it made.
     fn drained(&self) -> bool {
         match &self.session {
-            Some(s) if s.up => s.in_flight.is_empty() && s.cursor >= self.queue.next_number(),
-            _ => true,
+            Some(s) if s.up => {
+                s.refused || (s.in_flight.is_empty() && s.cursor >= self.queue.next_number())
+            }
+            Some(_) => false,
+            None => true,
         }
     }
 
@@ -472,14 +477,15 @@ impl Bridge {
             self.node.next_session();
             self.retry_after = FIRST_RETRY;
         }
-        let pause = if session.refused {
+        let pause = jitter(if session.refused {
             MAX_RETRY
         } else {
             self.retry_after
-        };
+        });
         self.report(format!(
-            "fleet: broker {broker}: {why}; {pending} records wait in the queue, retrying in {} s",
-            pause.as_secs()
+            "fleet: broker {broker}: {why}; {pending} records wait in the queue, retrying in \
+             {:.0} s",
+            pause.as_secs_f64()
         ));
         self.retry_after = (self.retry_after * 2).min(MAX_RETRY);
         pause
@@ -690,14 +696,30 @@ impl Bridge {
     }
 }
 
+/// Between 50 % and 100 % of `pause`, so that the nodes of a plant do not all reconnect in
+/// the same instant after their broker restarts.
+fn jitter(pause: Duration) -> Duration {
+    let nanos = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.subsec_nanos());
+    pause.mul_f64(0.5 + 0.5 * f64::from(nanos % 1000) / 1000.0)
+}
+
 /// A CONNACK refusal in words, with what to check.
 fn refusal(code: ConnectReturnCode, config: &FleetConfig) -> String {
     let user = config.username.as_deref().unwrap_or("(none)");
     match code {
-        ConnectReturnCode::BadUserNamePassword | ConnectReturnCode::NotAuthorized => format!(
+        ConnectReturnCode::BadUserNamePassword => format!(
+            "REFUSED the connection: {code:?} (the user name or password is wrong); check \
+             fleet.username ({user}) and fleet.password_file against the broker's password file"
+        ),
+        // mosquitto answers a wrong password with this code under MQTT 5.
+        ConnectReturnCode::NotAuthorized => format!(
             "REFUSED the connection: {code:?} (the user name or password is wrong, or the user \
-             may not connect); check fleet.username ({user}) and fleet.password_file against \
-             the broker's password file"
+             may not connect or not publish this node's death certificate \
+             spBv1.0/{}/NDEATH/{}); check fleet.username ({user}) and fleet.password_file \
+             against the broker's password file, and fleet.node_id against its ACL",
+            config.group_id, config.node_id
         ),
         ConnectReturnCode::ClientIdentifierNotValid | ConnectReturnCode::BadClientId => format!(
             "REFUSED the connection: {code:?}; check fleet.client_id ({})",

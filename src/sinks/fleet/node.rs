@@ -214,7 +214,12 @@ impl EdgeNode {
             topic: self.topic(Kind::DBirth, Some(&id)),
             payload: Payload {
                 timestamp: Some(now_ms),
-                metrics: book.birth_metrics(device, now_ms),
+                metrics: {
+                    // Every metric a DDATA may carry is declared at birth, the record number too.
+                    let mut metrics = book.birth_metrics(device, now_ms);
+                    metrics.push(Metric::named(RECORD, DataType::UInt64, now_ms, None));
+                    metrics
+                },
                 seq: Some(seq),
                 ..Payload::default()
             }
@@ -406,7 +411,8 @@ mod tests {
         );
         assert_eq!(decode(&births[1]).seq, Some(1));
         assert_eq!(decode(&births[2]).seq, Some(2));
-        assert_eq!(decode(&births[1]).metrics.len(), book.metric_count());
+        assert_eq!(decode(&births[1]).metrics.len(), book.metric_count() + 1);
+        assert!(metric(&decode(&births[1]), RECORD).is_some());
 
         // Data continues the seq, wrapping after 255.
         let record = book.observe(window(0, 10)).unwrap();
