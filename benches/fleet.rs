@@ -113,7 +113,7 @@ fn sizes() {
     let n = 20_000u64;
     let mut bytes = 0;
     for i in 0..n {
-        bytes += typical_ddata(&mut book, &mut node, t0 + 3000 + i * 1000).len();
+        bytes += typical_ddata(&mut book, &mut node, t0 + 10_000 + i * 1000).len();
     }
     let per = started.elapsed().as_secs_f64() / n as f64;
     println!(
@@ -246,14 +246,22 @@ async fn load(broker: &Mosquitto, nodes: usize, seconds: u64) {
     // The subscriber.
     let (sub, mut sub_loop) =
         AsyncClient::new(tls_options(broker, format!("load-sub-{nodes}")), 64);
-    sub.subscribe("spBv1.0/load/#", QoS::AtMostOnce)
-        .await
-        .unwrap();
     let sub_task = {
         let received = received.clone();
         let measuring = measuring.clone();
         tokio::spawn(async move {
-            while let Ok(event) = sub_loop.poll().await {
+            loop {
+                let event = match sub_loop.poll().await {
+                    Ok(event) => event,
+                    Err(e) => {
+                        eprintln!("load subscriber: {e}; reconnecting");
+                        tokio::time::sleep(Duration::from_millis(500)).await;
+                        continue;
+                    }
+                };
+                if let Event::Incoming(Packet::ConnAck(_)) = event {
+                    let _ = sub.try_subscribe("spBv1.0/load/#", QoS::AtMostOnce);
+                }
                 if let Event::Incoming(Packet::Publish(p)) = event {
                     if !measuring.load(Ordering::Relaxed) {
                         continue;
@@ -301,11 +309,13 @@ async fn load(broker: &Mosquitto, nodes: usize, seconds: u64) {
                     // Spread the nodes over the second.
                     tokio::time::sleep(Duration::from_millis((i as u64 * 997) % 1000)).await;
                     let mut tick = tokio::time::interval(Duration::from_secs(1));
-                    let mut k = 0u64;
+                    let mut last = 0u64;
                     loop {
                         tick.tick().await;
-                        k += 1;
-                        let payload = typical_ddata(&mut book, &mut node, now_ms() + k);
+                        // Stamped now (the subscriber's latency), at least a period after the
+                        // last (the book makes one record per period).
+                        last = now_ms().max(last + 1000);
+                        let payload = typical_ddata(&mut book, &mut node, last);
                         if client
                             .publish(topic.clone(), QoS::AtLeastOnce, false, payload)
                             .await
@@ -360,11 +370,14 @@ async fn load(broker: &Mosquitto, nodes: usize, seconds: u64) {
         t.abort();
     }
     sub_task.abort();
-    let mut r = received.lock().unwrap();
-    r.latencies_ms.sort_unstable();
+    let (count, mut latencies) = {
+        let mut r = received.lock().unwrap();
+        (r.count, std::mem::take(&mut r.latencies_ms))
+    };
+    latencies.sort_unstable();
     let pct = |q: f64| {
-        r.latencies_ms
-            .get(((r.latencies_ms.len() as f64 - 1.0) * q).round() as usize)
+        latencies
+            .get(((latencies.len() as f64 - 1.0) * q).round() as usize)
             .copied()
             .unwrap_or(0)
     };
@@ -372,14 +385,13 @@ async fn load(broker: &Mosquitto, nodes: usize, seconds: u64) {
         "| {nodes} | {}/{nodes} in {connect_s:.1} s | {:.0} | {:.0} | {} / {} / {} | {:.0} % | {rss:.0} | {} |",
         connected.load(Ordering::Relaxed),
         sent.load(Ordering::Relaxed) as f64 / window,
-        r.count as f64 / window,
+        count as f64 / window,
         pct(0.5),
         pct(0.99),
-        r.latencies_ms.last().copied().unwrap_or(0),
+        latencies.last().copied().unwrap_or(0),
         100.0 * cpu / window,
         errors.load(Ordering::Relaxed),
     );
-    drop(r);
     // Let the broker notice the departures before the next round.
     tokio::time::sleep(Duration::from_secs(3)).await;
 }

@@ -13,7 +13,8 @@
 //!
 //! The loop (every step is in `Bridge`):
 //! 1. observations → [`MetricBook`] → records → appended to the queue;
-//! 2. the queue is fsynced before anything appended is published;
+//! 2. the queue's appends are fsynced before anything appended is published (its
+//!    acknowledgements once a second);
 //! 3. while a session is up, records are published in order from the first unacknowledged,
 //!    at most `WINDOW` unacknowledged at a time; a PUBACK acknowledges its record;
 //! 4. a lost connection ends the session: what was not acknowledged is sent again in the next
@@ -46,6 +47,8 @@ const STOP_GRACE: Duration = Duration::from_secs(3);
 const FIRST_RETRY: Duration = Duration::from_secs(1);
 const MAX_RETRY: Duration = Duration::from_secs(30);
 const BD_SEQ_FILE: &str = "bdseq";
+/// How often the acknowledgements are recorded on disk.
+const HEAD_SYNC_EVERY: Duration = Duration::from_secs(1);
 
 /// Why the bridge could not start; each names the file or setting.
 #[derive(Debug, thiserror::Error)]
@@ -283,7 +286,7 @@ fn now_ms() -> u64 {
 
 /// What the client's event-loop task reports.
 enum SessionEvent {
-    Mqtt(Event),
+    Mqtt(Box<Event>),
     Down(ConnectionError),
 }
 
@@ -325,11 +328,10 @@ impl Bridge {
     async fn run(mut self, mut intake: mpsc::Receiver<Observation>) -> BridgeSummary {
         let mut retry_at = Instant::now();
         let mut stopping: Option<Instant> = None;
+        let mut head_synced = Instant::now();
         loop {
-            if stopping.is_none() && self.session.is_none() {
-                if Instant::now() >= retry_at {
-                    self.connect();
-                }
+            if stopping.is_none() && self.session.is_none() && Instant::now() >= retry_at {
+                self.connect();
             }
             tokio::select! {
                 observation = intake.recv(), if stopping.is_none() => match observation {
@@ -348,7 +350,7 @@ impl Bridge {
                         None => std::future::pending().await,
                     }
                 } => match event {
-                    Some(SessionEvent::Mqtt(event)) => self.on_event(event),
+                    Some(SessionEvent::Mqtt(event)) => self.on_event(*event),
                     Some(SessionEvent::Down(error)) => {
                         retry_at = Instant::now() + self.on_down(Some(error));
                     }
@@ -359,7 +361,16 @@ impl Bridge {
                 _ = tokio::time::sleep_until(retry_at), if self.session.is_none() && stopping.is_none() => {},
                 _ = tokio::time::sleep_until(stopping.unwrap_or_else(Instant::now)), if stopping.is_some() => break,
             }
-            if let Err(e) = self.queue.sync() {
+            // Appends are made durable before anything is published; the acknowledgements
+            // (two fsyncs and a rename) once a second: a crash resends at most that second's
+            // acknowledged records, with their record numbers (at-least-once).
+            let synced = if head_synced.elapsed() >= HEAD_SYNC_EVERY {
+                head_synced = Instant::now();
+                self.queue.sync()
+            } else {
+                self.queue.sync_appends()
+            };
+            if let Err(e) = synced {
                 self.report(format!("fleet: queue: {e}"));
             }
             self.pump();
@@ -425,7 +436,11 @@ impl Bridge {
             loop {
                 match eventloop.poll().await {
                     Ok(event) => {
-                        if events_tx.send(SessionEvent::Mqtt(event)).await.is_err() {
+                        if events_tx
+                            .send(SessionEvent::Mqtt(Box::new(event)))
+                            .await
+                            .is_err()
+                        {
                             return;
                         }
                     }
@@ -525,14 +540,13 @@ impl Bridge {
                     }
                 }
             }
-            Event::Incoming(Packet::Publish(publish)) => {
+            Event::Incoming(Packet::Publish(publish))
                 if publish.topic.as_ref() == self.node.command_topic().as_bytes()
-                    && self.node.command(&publish.payload) == Some(Command::Rebirth)
-                {
-                    eprintln!("bearingd: fleet: rebirth requested (NCMD): births sent again");
-                    let births = self.node.births(&self.book, now_ms());
-                    self.send(births);
-                }
+                    && self.node.command(&publish.payload) == Some(Command::Rebirth) =>
+            {
+                eprintln!("bearingd: fleet: rebirth requested (NCMD): births sent again");
+                let births = self.node.births(&self.book, now_ms());
+                self.send(births);
             }
             Event::Incoming(Packet::Disconnect(d)) => {
                 self.report(format!(
@@ -664,10 +678,13 @@ impl Bridge {
                 while let Ok(Some(event)) =
                     tokio::time::timeout_at(deadline, session.events.recv()).await
                 {
-                    if let SessionEvent::Mqtt(Event::Outgoing(Outgoing::Disconnect)) = event {
-                        break;
-                    }
-                    if let SessionEvent::Down(_) = event {
+                    let done = match &event {
+                        SessionEvent::Mqtt(e) => {
+                            matches!(**e, Event::Outgoing(Outgoing::Disconnect))
+                        }
+                        SessionEvent::Down(_) => true,
+                    };
+                    if done {
                         break;
                     }
                 }

@@ -67,7 +67,7 @@ pub fn decode_line(line: &str) -> Result<Json, DecodeError> {
 }
 
 fn from_hex(hex: &str) -> Result<Vec<u8>, DecodeError> {
-    if hex.len() % 2 != 0 {
+    if !hex.len().is_multiple_of(2) {
         return Err(DecodeError::Hex(format!("odd length {}", hex.len())));
     }
     (0..hex.len())

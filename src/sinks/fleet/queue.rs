@@ -22,7 +22,9 @@
 //!   a segment was created). The bridge syncs before it publishes anything appended, so a
 //!   record the broker saw is on disk.
 //! - Acknowledgements advance `head`, which is written to `head.new`, fsynced and renamed
-//!   over `head` at each sync. A crash between a PUBACK and that rename sends the record again
+//!   over `head` at each [`DiskQueue::sync`] (the bridge does that once a second and at its
+//!   stop; [`DiskQueue::sync_appends`] before each publish makes only the appends durable).
+//!   A crash between a PUBACK and that rename sends the record again
 //!   after the restart: at-least-once. Each resend carries the same record number (the bridge
 //!   puts it in the payload), which is how a subscriber sees the duplicate.
 //! - At open, segments are read frame by frame; the first frame that is short, has a bad CRC
@@ -39,7 +41,7 @@ use std::path::{Path, PathBuf};
 
 const FRAME_HEADER: usize = 16;
 const HEAD_FILE: &str = "head";
-/// Largest record accepted; a Sparkplug DDATA of bearingd is about 1 KiB.
+/// Largest record accepted; a DDATA of bearingd is under 0.5 KiB (docs/FLEET.md).
 pub const MAX_RECORD_BYTES: usize = 1 << 20;
 
 /// Why the queue could not do what was asked; each names the file.
@@ -377,6 +379,23 @@ impl DiskQueue {
         Ok(())
     }
 
+    /// Makes every append durable (fsync of the newest segment, and of the directory when a
+    /// segment was created), and nothing else: cheap when nothing was appended.
+    pub fn sync_appends(&mut self) -> Result<()> {
+        self.sync_tail()?;
+        self.sync_dir()
+    }
+
+    fn sync_dir(&mut self) -> Result<()> {
+        if self.dir_dirty {
+            let dir = File::open(&self.dir).map_err(io(&self.dir, "open the queue directory"))?;
+            dir.sync_all()
+                .map_err(io(&self.dir, "fsync the queue directory"))?;
+            self.dir_dirty = false;
+        }
+        Ok(())
+    }
+
     /// Makes every append durable (fsync), records the acknowledgements (`head`) and deletes
     /// segments that are fully acknowledged.
     pub fn sync(&mut self) -> Result<()> {
@@ -392,12 +411,7 @@ impl DiskQueue {
         if self.head != self.head_on_disk {
             self.write_head()?;
         }
-        if self.dir_dirty {
-            let dir = File::open(&self.dir).map_err(io(&self.dir, "open the queue directory"))?;
-            dir.sync_all()
-                .map_err(io(&self.dir, "fsync the queue directory"))?;
-            self.dir_dirty = false;
-        }
+        self.sync_dir()?;
         self.refresh_stats();
         Ok(())
     }
