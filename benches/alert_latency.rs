@@ -14,9 +14,9 @@
 //! Run: `cargo bench --bench alert_latency` (about `BENCH_ROUNDS` × 75 s).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use bearingd::clock::wall_clock_now_ns;
 use bearingd::iox::IoxSettings;
 use bearingd::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
-use bearingd::sources::wall_clock_now_ns;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

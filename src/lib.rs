@@ -11,7 +11,7 @@
 //! - [`sources`]: SocketCAN, iceoryx2, the simulated sensor and MCAP replay → sample blocks in
 //!   sample time, counting gaps, restarts, silent sensors and malformed frames.
 //! - [`sinks`]: where the pipeline's messages go: the MCAP log writer, iceoryx2 alerts, the
-//!   systemd notify protocol.
+//!   systemd notify protocol, the fleet bridge (MQTT Sparkplug B with store-and-forward).
 //! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
 //! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
@@ -32,12 +32,14 @@
 //! - [`messages`]: the vocabulary every room above speaks: typed faults, flags, health stages,
 //!   speed sources and the pipeline's messages; MCAP and iceoryx2 encode them at the edge.
 //! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies.
+//! - [`clock`]: the one reading of the system clock, for the daemon's edges (sources, sinks).
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
 
 pub mod analysis;
 pub mod bearing;
 pub mod cli;
+pub mod clock;
 pub mod config;
 pub mod daemon;
 pub mod iox;

@@ -9,6 +9,7 @@
 mod alerts;
 mod analyze;
 mod config_cmd;
+mod fleet_decode;
 mod import;
 mod ingest;
 mod replay;
@@ -106,6 +107,9 @@ enum Command {
     /// Print the daemon's active alerts, then each alert as it comes (iceoryx2).
     #[cfg(feature = "shm")]
     Alerts(alerts::AlertsArgs),
+    /// Decode Sparkplug B messages of the fleet bridge: reads `TOPIC HEX` lines as printed by
+    /// `mosquitto_sub -v -F '%t %x' -t 'spBv1.0/#'` and prints one JSON object per message.
+    FleetDecode(fleet_decode::FleetDecodeArgs),
     /// Configuration helpers.
     Config {
         #[command(subcommand)]
@@ -125,6 +129,7 @@ pub fn main() -> ExitCode {
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),
+        Command::FleetDecode(args) => fleet_decode::run(&args),
         #[cfg(feature = "shm")]
         Command::Alerts(args) => alerts::run(&args),
     };

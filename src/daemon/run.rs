@@ -32,16 +32,18 @@
 
 use super::events::{DaemonEvent, Events};
 use super::state::{load_baselines, save_baselines};
+use crate::clock::wall_clock_now_ns;
 use crate::config::{Config, Transport};
 use crate::mcap_log::McapLogError;
 use crate::messages::{FlagMessage, PipelineMessage, TwinMessage};
 use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinRequest, TwinWorker};
 use crate::sinks::alerts::PublisherSummary;
+use crate::sinks::fleet::FleetSink;
 use crate::sinks::mcap::McapSink;
 use crate::sinks::systemd::{keep_alive, status_text, Notifier};
 use crate::sources::live::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
 use crate::sources::sim::SimSource;
-use crate::sources::{wall_clock_now_ns, Arrived};
+use crate::sources::Arrived;
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::Duration;
@@ -77,6 +79,8 @@ pub enum RunError {
     #[cfg(feature = "shm")]
     #[error("alerts: {0}")]
     Alerts(#[from] crate::sinks::alerts::AlertError),
+    #[error("fleet bridge: {0}")]
+    Fleet(#[from] crate::sinks::fleet::bridge::BridgeError),
     #[error("{what} thread failed: {detail}")]
     Thread { what: &'static str, detail: String },
     #[error("sink thread failed: {0}")]
@@ -114,7 +118,12 @@ pub async fn run(
     shutdown: impl std::future::Future<Output = ()>,
 ) -> Result<RunSummary, RunError> {
     let state_dir = prepare_state_dir(&config)?;
-    sinks.push(Box::new(open_log(&config, &events)?));
+    // Wall time of sample 0: the log's time base, and the fleet bridge's.
+    let origin_ns = wall_clock_now_ns();
+    sinks.push(Box::new(open_log(&config, origin_ns, &events)?));
+    if let Some(fleet) = start_fleet(&config, origin_ns, &events)? {
+        sinks.push(Box::new(fleet));
+    }
     let alerts = start_alerts(&config, &events)?;
     let (baselines, problem) = load_baselines(&state_dir);
     if let Some(problem) = problem {
@@ -198,8 +207,8 @@ fn prepare_state_dir(config: &Config) -> Result<PathBuf, RunError> {
 }
 
 /// Recovers what a crash left in the log directory and opens the log, sample 0 at now.
-fn open_log(config: &Config, events: &Events) -> Result<McapSink, RunError> {
-    let (log, recovered) = McapSink::for_config(config, wall_clock_now_ns())?;
+fn open_log(config: &Config, origin_ns: u64, events: &Events) -> Result<McapSink, RunError> {
+    let (log, recovered) = McapSink::for_config(config, origin_ns)?;
     for report in recovered {
         events(DaemonEvent::Recovered(report));
     }
@@ -207,6 +216,17 @@ fn open_log(config: &Config, events: &Events) -> Result<McapSink, RunError> {
         events(DaemonEvent::LoggingTo(path.to_path_buf()));
     }
     Ok(log)
+}
+
+/// The fleet bridge of `[fleet]`, when it is on; its notices become [`DaemonEvent::Fleet`].
+fn start_fleet(
+    config: &Config,
+    origin_ns: u64,
+    events: &Events,
+) -> Result<Option<FleetSink>, RunError> {
+    let events = events.clone();
+    let notices = std::sync::Arc::new(move |line| events(DaemonEvent::Fleet(line)));
+    Ok(FleetSink::start(config, origin_ns, notices)?)
 }
 
 /// The alert service `outputs.alerts_service` under `outputs.iceoryx2_root`.

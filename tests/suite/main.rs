@@ -7,6 +7,7 @@ mod cli;
 mod daemon;
 mod developer_set;
 mod envelope;
+mod fleet;
 mod formats;
 mod kinematics;
 mod monitor;
