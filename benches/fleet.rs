@@ -7,6 +7,7 @@
 //!
 //! Needs mosquitto, mosquitto_passwd and openssl (Debian packages); the broker is the tests'
 //! (TLS, passwords, ACL), started in a temporary directory.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 #[path = "../tests/suite/fleet/broker.rs"]
 mod broker;
