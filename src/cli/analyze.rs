@@ -61,9 +61,17 @@ pub struct AnalyzeArgs {
     /// twin's spectrum to the text and the plot).
     #[arg(long)]
     twin: bool,
+    /// Instead of the diagnosis: identify the Hammerstein–Wiener model (seed 003) for state
+    /// orders 0…9 on each record and print its accuracy and time per order, and the mean per
+    /// directory (bearing).
+    #[arg(long, conflicts_with_all = ["demo", "twin", "plot"])]
+    hw: bool,
 }
 
 pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
+    if args.hw {
+        return super::hw_table::run(&args.files, &args.recording);
+    }
     let settings = settings_from(args)?;
     let files: Vec<Option<PathBuf>> = if args.demo {
         vec![None]

@@ -9,6 +9,7 @@
 mod alerts;
 mod analyze;
 mod config_cmd;
+mod hw_table;
 mod import;
 mod ingest;
 mod replay;
