@@ -26,14 +26,14 @@ pub struct TransferFunction {
 impl TransferFunction {
     /// `x = B/F·q^{−delay}·u` from rest (zero initial conditions); `x.len() == u.len()`.
     pub fn simulate(&self, u: &[f64], x: &mut [f64]) {
-        for k in 0..x.len() {
+        for (k, out) in x.iter_mut().enumerate() {
             let mut acc = 0.0;
             for (m, &b) in self.b.iter().enumerate() {
                 if let Some(i) = k.checked_sub(self.delay + m) {
                     acc += b * u[i];
                 }
             }
-            x[k] = acc;
+            *out = acc;
         }
         filter_denominator(&self.f, x);
     }
