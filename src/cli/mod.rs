@@ -10,6 +10,7 @@ mod alerts;
 mod analyze;
 mod config_cmd;
 mod fleet_decode;
+mod hw_table;
 mod import;
 mod ingest;
 mod replay;

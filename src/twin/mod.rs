@@ -4,6 +4,7 @@
 
 pub mod diagnose;
 pub mod fit;
+pub mod hw;
 pub mod model;
 pub mod optimize;
 pub mod rng;
