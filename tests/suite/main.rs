@@ -8,5 +8,6 @@ mod developer_set;
 mod envelope;
 mod kinematics;
 mod monitor;
+mod physics;
 mod speed;
 mod twin;

@@ -413,6 +413,7 @@ impl Dynamics {
 
     /// Total mechanical energy (kinetic, springs, Hertz contacts `2/5·k_b·δ^{5/2}`, and the
     /// load's potential `F_r·y_s`), J. Conserved without damping and rotation.
+    #[cfg(test)]
     pub(crate) fn energy(&self, t: f64, y: &State) -> f64 {
         let m = |i: usize| y[i] / LENGTH_SCALE;
         let v = |i: usize| y[6 + i] * OMEGA_REF / LENGTH_SCALE;

@@ -44,13 +44,16 @@
 //! - [`PhysicsModel`]: the same, streaming (`fill` block by block), with integration counters.
 //! - [`PhysicsError`]: every unusable parameter is named with its fix (`Invalid`); a model
 //!   that cannot be integrated says when and why (`Integration`). No panic on any input.
+//! - [`calibrate`]: fits `k_r`, `c_r`, `k_b` and the defect width to a measured record.
 //!
 //! The model, the integrator and its accuracy, the calibration and the measured speed:
 //! docs/PHYSICS.md.
 
+mod calibrate;
 mod dynamics;
 mod model;
 mod params;
 
+pub use calibrate::{calibrate, Calibration, CalibrationSettings, SPECTRUM_WINDOW};
 pub use model::{simulate, IntegrationStats, PhysicsModel};
 pub use params::{hertz_contact_stiffness, Dof, PhysicsError, PhysicsParams, Structure};
