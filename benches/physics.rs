@@ -68,7 +68,7 @@ fn main() {
             params.duration_s = 2.0;
             let s = &mut params.structure;
             s.resonator_stiffness =
-                s.resonator_mass_kg * (std::f64::consts::TAU * resonance as f64).powi(2);
+                s.resonator_mass_kg * (std::f64::consts::TAU * resonance).powi(2);
             s.resonator_damping = 2.0 * 0.05 * (s.resonator_stiffness * s.resonator_mass_kg).sqrt();
             let (wall_rate, cpu_rate, evaluations) = simulation_rate(&params);
             println!(

@@ -102,7 +102,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), CliError> {
         })?),
         None => None,
     };
-    if !(args.population >= 4 && args.generations >= 1) {
+    if args.population < 4 || args.generations < 1 {
         return Err(CliError::input(
             "--population must be at least 4 and --generations at least 1, e.g. --population 24 --generations 24",
         ));

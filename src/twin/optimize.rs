@@ -225,17 +225,18 @@ pub fn differential_evolution<const N: usize>(
                 let a = pick(&mut rng, &[i]);
                 let b = pick(&mut rng, &[i, a]);
                 let forced = (rng.next_u64() % N as u64) as usize;
-                let mut trial = points[i];
-                for d in 0..N {
+                let parent = points[i];
+                let mut trial = parent;
+                for (d, coordinate) in trial.iter_mut().enumerate() {
                     if d == forced || rng.uniform() < settings.crossover {
-                        let v = points[i][d]
-                            + scale * (state.best[d] - points[i][d])
+                        let v = parent[d]
+                            + scale * (state.best[d] - parent[d])
                             + scale * (points[a][d] - points[b][d]);
                         // Out of the cube: halfway back to the parent's coordinate.
-                        trial[d] = if v < 0.0 {
-                            points[i][d] / 2.0
+                        *coordinate = if v < 0.0 {
+                            parent[d] / 2.0
                         } else if v > 1.0 {
-                            (points[i][d] + 1.0) / 2.0
+                            (parent[d] + 1.0) / 2.0
                         } else {
                             v
                         };
@@ -246,10 +247,14 @@ pub fn differential_evolution<const N: usize>(
             .collect();
         let trial_values = evaluate(&trials);
         evaluations += size;
-        for i in 0..size {
-            if trial_values[i] <= values[i] {
-                points[i] = trials[i];
-                values[i] = trial_values[i];
+        for ((point, value), (trial, trial_value)) in points
+            .iter_mut()
+            .zip(values.iter_mut())
+            .zip(trials.iter().zip(&trial_values))
+        {
+            if trial_value <= value {
+                *point = *trial;
+                *value = *trial_value;
             }
         }
         let (best, best_value) = best_of(&points, &values);

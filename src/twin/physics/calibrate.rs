@@ -224,7 +224,8 @@ pub fn calibrate(
             settings.resonance_hz.1
         ));
     }
-    if !(settings.simulated_s * base.fs_hz >= 4.0 * SPECTRUM_WINDOW as f64) {
+    let simulated_samples = settings.simulated_s * base.fs_hz;
+    if simulated_samples.is_nan() || simulated_samples < 4.0 * SPECTRUM_WINDOW as f64 {
         problems.push(format!(
             "simulated length {} s gives fewer than {} samples",
             settings.simulated_s,

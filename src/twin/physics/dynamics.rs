@@ -349,8 +349,8 @@ impl Dynamics {
         let ayp = (-self.cp * vyp - self.kp * yp + fy + resonator_y) / self.mp;
         let aux = if self.five_dof { 0.0 } else { arx - axp };
         let auy = ary - ayp;
-        for i in 0..6 {
-            dy[i] = OMEGA_REF * y[6 + i];
+        for (position_rate, velocity) in dy.iter_mut().zip(y.iter().skip(6)).take(6) {
+            *position_rate = OMEGA_REF * velocity;
         }
         let to_state = LENGTH_SCALE / OMEGA_REF;
         for (i, a) in [axs, ays, axp, ayp, aux, auy].into_iter().enumerate() {
