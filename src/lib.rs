@@ -21,8 +21,9 @@
 //!   per section), with every problem reported at once.
 //! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the
 //!   `bearing-iox` crate, shared with the publishers).
-//! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits)
-//!   and the Hammerstein–Wiener identification (`twin::hw`).
+//! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits),
+//!   the 6-DOF physics model and its calibration (`twin::physics`), and the
+//!   Hammerstein–Wiener identification (`twin::hw`).
 //! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
 //!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
 //!   cannot disagree.

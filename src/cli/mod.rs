@@ -8,6 +8,7 @@
 #[cfg(feature = "shm")]
 mod alerts;
 mod analyze;
+mod calibrate;
 mod config_cmd;
 mod fleet_decode;
 mod hw_table;
@@ -96,8 +97,11 @@ enum Command {
     Import(import::ImportArgs),
     /// Replay MCAP logs' raw samples through the same pipeline, as fast as possible or at --speed.
     Replay(replay::ReplayArgs),
-    /// Write a synthetic record of a bearing fault (the twin's signal model) as CSV or WAV.
+    /// Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV.
     Simulate(simulate::SimulateArgs),
+    /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
+    /// to a measured record; prints the parameters and the fit error, plots the spectra.
+    Calibrate(calibrate::CalibrateArgs),
     /// Check a configuration file; lists every problem with its key and how to fix it.
     Validate {
         /// The TOML file to check.
@@ -127,6 +131,7 @@ pub fn main() -> ExitCode {
         Command::Replay(args) => replay::run(&args),
         Command::Import(args) => import::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),

@@ -11,6 +11,7 @@ mod fleet;
 mod formats;
 mod kinematics;
 mod monitor;
+mod physics;
 mod severity;
 mod speed;
 mod twin;
