@@ -7,10 +7,12 @@
 //! Run: `cargo bench --bench physics`. A bench command rather than criterion: one calibration
 //! takes seconds, and what matters is the rate, not a confidence interval over microseconds.
 //! Without ../shared/data the calibration part says so and is skipped (CI=true: fails).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::record::analyze_record;
-use bearingd::analysis::{AnalysisSettings, FaultKind};
+use bearingd::analysis::AnalysisSettings;
 use bearingd::bearing::BearingGeometry;
+use bearingd::messages::FaultKind;
 use bearingd::recording::{read_recording, ReadOptions};
 use bearingd::twin::physics::{calibrate, CalibrationSettings, Dof, PhysicsModel, PhysicsParams};
 use bearingd::twin::SimulatedFault;
@@ -19,6 +21,8 @@ use std::time::Instant;
 
 /// CPU time used so far by this thread (`RUSAGE_THREAD`) or the whole process, s. Reported
 /// beside the wall clock because the machine may be shared: CPU time is what the work costs.
+/// `getrusage` has no safe API in std: the one unsafe call of this bench, allowed here alone.
+#[allow(unsafe_code)]
 fn cpu_seconds(who: libc::c_int) -> f64 {
     // SAFETY: getrusage only writes the struct it is given.
     let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
@@ -63,7 +67,7 @@ fn main() {
             (Dof::Six, 3_200.0),
             (Dof::Five, 3_200.0),
         ] {
-            let mut params = PhysicsParams::cwru(fault);
+            let mut params = PhysicsParams::cwru(fault).unwrap();
             params.dof = dof;
             params.duration_s = 2.0;
             let s = &mut params.structure;

@@ -314,7 +314,7 @@ mod tests {
     /// allows), much better than the defaults, with the resonance where it was put.
     #[test]
     fn calibration_recovers_a_known_resonance_from_a_simulated_record() {
-        let mut truth = PhysicsParams::cwru(SimulatedFault::OuterRace);
+        let mut truth = PhysicsParams::cwru(SimulatedFault::OuterRace).unwrap();
         truth.duration_s = 2.0;
         truth.noise_g = 0.002;
         let s = &mut truth.structure;
@@ -326,7 +326,7 @@ mod tests {
         let band = Band::new(2_000.0, 4_500.0);
         let mut settings = CalibrationSettings::for_band(band, truth.fs_hz);
         settings.generations = 15;
-        let base = PhysicsParams::cwru(SimulatedFault::OuterRace);
+        let base = PhysicsParams::cwru(SimulatedFault::OuterRace).unwrap();
         let mut calls = 0;
         let fit = calibrate(&measured, &base, band, &settings, |_| calls += 1).unwrap();
         assert_eq!(calls, fit.history.len());
@@ -347,7 +347,7 @@ mod tests {
 
     #[test]
     fn a_bad_band_or_a_short_record_is_an_error() {
-        let base = PhysicsParams::cwru(SimulatedFault::OuterRace);
+        let base = PhysicsParams::cwru(SimulatedFault::OuterRace).unwrap();
         let settings = CalibrationSettings::for_band(Band::new(2_000.0, 4_000.0), 12_000.0);
         let message = calibrate(
             &[0.0; 100],

@@ -459,7 +459,7 @@ mod tests {
 
     #[test]
     fn equilibrium_balances_the_load() {
-        let p = PhysicsParams::cwru(SimulatedFault::None);
+        let p = PhysicsParams::cwru(SimulatedFault::None).unwrap();
         let dynamics = Dynamics::new(&p);
         let y = dynamics.equilibrium();
         let mut dy = State::zeros();

@@ -314,7 +314,8 @@ mod tests {
     #[test]
     fn energy_is_conserved_without_damping_or_rotation() {
         for fault in [SimulatedFault::None, SimulatedFault::OuterRace] {
-            let dynamics = Dynamics::new(&PhysicsParams::cwru(fault)).without_damping_or_rotation();
+            let dynamics =
+                Dynamics::new(&PhysicsParams::cwru(fault).unwrap()).without_damping_or_rotation();
             let rest = dynamics.energy(0.0, &dynamics.equilibrium());
             let states = trajectory(&dynamics, knocked(&dynamics), 0.05, 1e-10);
             let start = dynamics.energy(0.0, &states[0]) - rest;
@@ -334,7 +335,7 @@ mod tests {
 
     #[test]
     fn damping_only_takes_energy_away() {
-        let mut dynamics = Dynamics::new(&PhysicsParams::cwru(SimulatedFault::None));
+        let mut dynamics = Dynamics::new(&PhysicsParams::cwru(SimulatedFault::None).unwrap());
         // Damped but standing still: no work from rotating contacts.
         let damped = dynamics.clone();
         dynamics = dynamics.without_damping_or_rotation();
@@ -351,7 +352,7 @@ mod tests {
 
     #[test]
     fn the_record_does_not_depend_on_how_it_is_cut_into_blocks() {
-        let mut params = PhysicsParams::cwru(SimulatedFault::InnerRace);
+        let mut params = PhysicsParams::cwru(SimulatedFault::InnerRace).unwrap();
         params.duration_s = 0.3;
         params.noise_g = 0.01;
         params.slip = 0.01;
@@ -371,7 +372,7 @@ mod tests {
 
     #[test]
     fn unusable_parameters_are_errors_not_panics() {
-        let mut params = PhysicsParams::cwru(SimulatedFault::Ball);
+        let mut params = PhysicsParams::cwru(SimulatedFault::Ball).unwrap();
         params.structure.contact_stiffness = f64::INFINITY;
         assert!(matches!(
             simulate(&params),
@@ -382,7 +383,7 @@ mod tests {
     /// CWRU's bearing at 1797 rpm with the resonator moved to 3.2 kHz (inside the 12 kHz
     /// band, where CWRU's drive-end resonance is), `seconds` long.
     fn in_band(fault: SimulatedFault, dof: Dof, seconds: f64) -> PhysicsParams {
-        let mut params = PhysicsParams::cwru(fault);
+        let mut params = PhysicsParams::cwru(fault).unwrap();
         params.dof = dof;
         params.duration_s = seconds;
         let s = &mut params.structure;
@@ -427,6 +428,7 @@ mod tests {
     #[test]
     fn fault_lines_match_the_kinematic_frequencies_within_one_percent() {
         let freqs = PhysicsParams::cwru(SimulatedFault::None)
+            .unwrap()
             .bearing
             .fault_frequencies(1797.0 / 60.0);
         for (fault, dof, expected) in [
@@ -516,6 +518,7 @@ mod tests {
     #[test]
     fn an_inner_race_defect_is_modulated_by_the_load_zone() {
         let freqs = PhysicsParams::cwru(SimulatedFault::None)
+            .unwrap()
             .bearing
             .fault_frequencies(1797.0 / 60.0);
         let sideband_ratio = |fault: SimulatedFault, line: f64| {
