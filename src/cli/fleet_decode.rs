@@ -1,6 +1,8 @@
 //! `bearingd fleet-decode`: Sparkplug B messages from any MQTT client's output as JSON lines.
 //!
-//!     mosquitto_sub -h BROKER -t 'spBv1.0/#' -F '%t %x' | bearingd fleet-decode
+//! ```text
+//! mosquitto_sub -h BROKER -t 'spBv1.0/#' -F '%t %x' | bearingd fleet-decode
+//! ```
 
 use super::CliError;
 use crate::sinks::fleet::decode::decode_line;
