@@ -23,9 +23,9 @@
 //! comparison on the same machine load).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+use bearingd::clock::wall_clock_now_ns;
 use bearingd::iox::IoxSettings;
 use bearingd::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
-use bearingd::sources::wall_clock_now_ns;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

@@ -4,11 +4,11 @@
 //! Why here and not in the config: the catalog and the equations are used by `analyze`, the
 //! twin and the daemon alike; the config only names a bearing or gives custom geometry.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// Geometry of a rolling-element bearing, in millimetres and degrees.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BearingGeometry {
     /// Catalog name, or `custom` for geometry given by hand.
     pub name: String,

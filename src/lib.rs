@@ -11,7 +11,7 @@
 //! - [`sources`]: SocketCAN, iceoryx2, the simulated sensor and MCAP replay → sample blocks in
 //!   sample time, counting gaps, restarts, silent sensors and malformed frames.
 //! - [`sinks`]: where the pipeline's messages go: the MCAP log writer, iceoryx2 alerts, the
-//!   systemd notify protocol.
+//!   systemd notify protocol, the fleet bridge (MQTT Sparkplug B with store-and-forward).
 //! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
 //!   SNR, speed and bearing through the real pipeline (`bearingd evaluate`).
 //! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
@@ -24,7 +24,9 @@
 //!   per section), with every problem reported at once.
 //! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the
 //!   `bearing-iox` crate, shared with the publishers).
-//! - [`twin`]: the signal-model twin of a defective bearing: simulation and online fits.
+//! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits),
+//!   the 6-DOF physics model and its calibration (`twin::physics`), and the
+//!   Hammerstein–Wiener identification (`twin::hw`).
 //! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
 //!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
 //!   cannot disagree.
@@ -37,12 +39,14 @@
 //! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies.
 //! - [`random`]: seeded random numbers (ChaCha8), the same on every machine, for the simulator
 //!   and for tests at every level.
+//! - [`clock`]: the one reading of the system clock, for the daemon's edges (sources, sinks).
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
 
 pub mod analysis;
 pub mod bearing;
 pub mod cli;
+pub mod clock;
 pub mod config;
 pub mod daemon;
 pub mod evaluate;

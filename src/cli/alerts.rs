@@ -7,12 +7,12 @@
 
 use super::run::embedded_config;
 use super::CliError;
+use crate::clock::wall_clock_now_ns;
 use crate::config;
 use crate::iox::IoxSettings;
 use crate::sinks::alerts::payload::AlertDecodeError;
 use crate::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
 use crate::sinks::alerts::{Alert, AlertState};
-use crate::sources::wall_clock_now_ns;
 use clap::Args;
 use std::collections::BTreeMap;
 use std::path::PathBuf;

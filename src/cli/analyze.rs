@@ -70,6 +70,11 @@ pub struct AnalyzeArgs {
     /// Foundation for the velocity zones: rigid or flexible.
     #[arg(long, value_enum, default_value = "rigid")]
     foundation: FoundationArg,
+    /// Instead of the diagnosis: identify the Hammerstein–Wiener model (seed 003) for state
+    /// orders 0…9 on each record and print its accuracy and time per order, and the mean per
+    /// directory (bearing).
+    #[arg(long, conflicts_with_all = ["demo", "twin", "plot"])]
+    hw: bool,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -93,6 +98,9 @@ fn severity_from(args: &AnalyzeArgs) -> SeveritySettings {
 }
 
 pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
+    if args.hw {
+        return super::hw_table::run(&args.files, &args.recording);
+    }
     let settings = settings_from(args)?;
     let files: Vec<Option<PathBuf>> = if args.demo {
         vec![None]

@@ -8,8 +8,11 @@
 #[cfg(feature = "shm")]
 mod alerts;
 mod analyze;
+mod calibrate;
 mod config_cmd;
 mod evaluate;
+mod fleet_decode;
+mod hw_table;
 mod import;
 mod ingest;
 mod replay;
@@ -98,8 +101,11 @@ enum Command {
     /// Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records)
     /// through the real pipeline: detection probability, false alarms, confusion matrix, plot.
     Evaluate(evaluate::EvaluateArgs),
-    /// Write a synthetic record of a bearing fault (the twin's signal model) as CSV or WAV.
+    /// Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV.
     Simulate(simulate::SimulateArgs),
+    /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
+    /// to a measured record; prints the parameters and the fit error, plots the spectra.
+    Calibrate(calibrate::CalibrateArgs),
     /// Check a configuration file; lists every problem with its key and how to fix it.
     Validate {
         /// The TOML file to check.
@@ -110,6 +116,9 @@ enum Command {
     /// Print the daemon's active alerts, then each alert as it comes (iceoryx2).
     #[cfg(feature = "shm")]
     Alerts(alerts::AlertsArgs),
+    /// Decode Sparkplug B messages of the fleet bridge: reads `TOPIC HEX` lines as printed by
+    /// `mosquitto_sub -v -F '%t %x' -t 'spBv1.0/#'` and prints one JSON object per message.
+    FleetDecode(fleet_decode::FleetDecodeArgs),
     /// Configuration helpers.
     Config {
         #[command(subcommand)]
@@ -127,9 +136,11 @@ pub fn main() -> ExitCode {
         Command::Import(args) => import::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Evaluate(args) => evaluate::run(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),
+        Command::FleetDecode(args) => fleet_decode::run(&args),
         #[cfg(feature = "shm")]
         Command::Alerts(args) => alerts::run(&args),
     };

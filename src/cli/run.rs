@@ -31,6 +31,11 @@ pub struct RunArgs {
     /// No status lines (flags and the summary are still printed).
     #[arg(long)]
     quiet: bool,
+    /// Also publish to this MQTT broker (mqtt://HOST:PORT or mqtts://HOST:PORT) with the fleet
+    /// bridge's defaults, node id = this host's name: a first look; a service sets [fleet] in
+    /// its config (docs/FLEET.md).
+    #[arg(long, value_name = "BROKER")]
+    fleet: Option<String>,
 }
 
 /// Prints every flag change as it happens.
@@ -59,7 +64,7 @@ impl Sink for FlagPrinter {
 }
 
 pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
-    let config = match &args.config {
+    let mut config = match &args.config {
         Some(path) => {
             let mut config = config::load(path).map_err(CliError::input)?;
             if let Some(data) = &args.data_dir {
@@ -77,6 +82,12 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         }
         None => embedded_default(args)?,
     };
+    if let Some(broker) = &args.fleet {
+        let fleet =
+            config::FleetConfig::for_broker(broker, &host_node_id(), &config.outputs.state_dir)
+                .map_err(CliError::input)?;
+        config.fleet = Some(fleet);
+    }
     let options = RunOptions {
         duration_s: args.duration,
         realtime: !args.fast,
@@ -215,6 +226,7 @@ fn event_line(event: &DaemonEvent) -> String {
         DaemonEvent::SourceStopped { source, error } => {
             format!("bearingd: {source} stopped: {error}")
         }
+        DaemonEvent::Fleet(line) => format!("bearingd: {line}"),
         DaemonEvent::SourceTaskFailed(error) => format!("bearingd: a source task failed: {error}"),
         DaemonEvent::UnknownChannel { channel, blocks } => format!(
             "bearingd: {blocks} blocks of {channel} skipped: no such sensor/axis in the config"
@@ -319,4 +331,27 @@ pub fn status_line(s: &ChannelStatus) -> String {
         },
         if s.sensor_lost { " SENSOR LOST" } else { "" }
     )
+}
+
+/// This host's name as a Sparkplug node id (characters outside `A-Z a-z 0-9 - _ .` become
+/// `-`); `bearingd` when it has none.
+fn host_node_id() -> String {
+    let name = std::fs::read_to_string("/proc/sys/kernel/hostname").unwrap_or_default();
+    let id: String = name
+        .trim()
+        .chars()
+        .take(64)
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.') {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    if id.is_empty() {
+        "bearingd".into()
+    } else {
+        id
+    }
 }

@@ -1,11 +1,15 @@
-//! `bearingd simulate`: write a synthetic record of the twin's signal model, so that anyone can
-//! produce a known fault and check what bearingd makes of it.
+//! `bearingd simulate`: write a synthetic record of a bearing fault, so that anyone can produce
+//! a known fault and check what bearingd makes of it: from the twin's signal model (impacts
+//! ringing a resonance, MODELS.md §4) or from the physics twin (the 6-DOF contact model,
+//! MODELS.md §5, optionally with parameters calibrated to a real machine).
 
+use super::calibrate::DofArg;
 use super::CliError;
 use crate::bearing::BearingGeometry;
+use crate::twin::physics::{PhysicsModel, PhysicsParams};
 use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
 use clap::{Args, ValueEnum};
-use std::io::Write;
+use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -17,8 +21,30 @@ pub enum FaultArg {
     Cage,
 }
 
+impl From<FaultArg> for SimulatedFault {
+    fn from(fault: FaultArg) -> Self {
+        match fault {
+            FaultArg::None => SimulatedFault::None,
+            FaultArg::Outer => SimulatedFault::OuterRace,
+            FaultArg::Inner => SimulatedFault::InnerRace,
+            FaultArg::Ball => SimulatedFault::Ball,
+        }
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ModelArg {
+    /// The signal model: decaying impacts on a resonance (fast, every shape parameter free).
+    Signal,
+    /// The physics twin: masses, springs and Hertz contacts integrated in time.
+    Physics,
+}
+
 #[derive(Args)]
 pub struct SimulateArgs {
+    /// Which model makes the record.
+    #[arg(long, value_enum, default_value = "signal")]
+    model: ModelArg,
     /// The defect.
     #[arg(long, value_enum, default_value = "outer")]
     fault: FaultArg,
@@ -37,32 +63,52 @@ pub struct SimulateArgs {
     /// Output file: .csv (one column, g) or .wav (32-bit float, g).
     #[arg(long)]
     out: PathBuf,
-    /// Impact amplitude a at full load, g.
+    /// Physics model: radial load, N.
+    #[arg(long, default_value_t = 1000.0)]
+    load: f64,
+    /// Physics model: defect width, mm (CWRU: 0.178, 0.356, 0.533).
+    #[arg(long, default_value_t = 0.178)]
+    defect_width: f64,
+    /// Physics model: damping ratio of the resonator (its resonance is --resonance).
+    #[arg(long, default_value_t = 0.05)]
+    damping_ratio: f64,
+    /// Physics model: six degrees of freedom (seed 001) or five (seed 003).
+    #[arg(long, value_enum, default_value = "six")]
+    dof: DofArg,
+    /// Physics model: parameters saved by `bearingd calibrate --save` (JSON); they replace the
+    /// structure (k_r, c_r, k_b, …), the defect width, the load and the model; --fault, --rpm,
+    /// --fs, --duration, --noise, --jitter and --seed still apply.
+    #[arg(long)]
+    calibrated: Option<PathBuf>,
+    /// Signal model: impact amplitude a at full load, g.
     #[arg(long, default_value_t = 1.0)]
     amplitude: f64,
-    /// Decay rate B of each impact, 1/s.
+    /// Signal model: decay rate B of each impact, 1/s.
     #[arg(long, default_value_t = 800.0)]
     decay: f64,
-    /// Structural resonance f_n, Hz.
+    /// Structural resonance f_n, Hz (physics model: the resonator's, which sets k_r).
     #[arg(long, default_value_t = 3_000.0)]
     resonance: f64,
-    /// Stribeck load-zone factor ε (0.5: half the bearing loaded).
+    /// Signal model: Stribeck load-zone factor ε (0.5: half the bearing loaded).
     #[arg(long, default_value_t = 0.5)]
     load_zone: f64,
-    /// Impact-time jitter (slip), as a fraction of the impact period.
+    /// Impact-time jitter (slip), as a fraction of the impact period (physics model: the cage's
+    /// slip per ball pass).
     #[arg(long, default_value_t = 0.01)]
     jitter: f64,
-    /// Defect length in mm (0: one impact per passage; above: entry and exit impacts).
+    /// Signal model: defect length in mm (0: one impact per passage; above: entry and exit
+    /// impacts).
     #[arg(long, default_value_t = 0.0)]
     defect_length: f64,
     /// White noise, g (standard deviation).
     #[arg(long, default_value_t = 0.2)]
     noise: f64,
-    /// Add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated
-    /// noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md).
+    /// Signal model: add what a real machine adds besides the bearing (shaft harmonics,
+    /// shaft-modulated noise, random impulses, a gear mesh and a 100 Hz tone; see
+    /// docs/DIAGNOSIS.md).
     #[arg(long)]
     nuisance: bool,
-    /// The fault appears at this time, s.
+    /// Signal model: the fault appears at this time, s.
     #[arg(long, default_value_t = 0.0)]
     onset: f64,
     /// Random seed: the same seed gives the same record.
@@ -129,36 +175,35 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
     if !problems.is_empty() {
         return Err(CliError::input(problems.join("; ")));
     }
-    let params = SimulationParams {
-        fault: match args.fault {
-            FaultArg::None => SimulatedFault::None,
-            FaultArg::Outer => SimulatedFault::OuterRace,
-            FaultArg::Inner => SimulatedFault::InnerRace,
-            FaultArg::Ball => SimulatedFault::Ball,
-            FaultArg::Cage => SimulatedFault::Cage,
-        },
-        rpm: args.rpm,
-        bearing: bearing.clone(),
-        fs_hz: args.fs,
-        amplitude_g: args.amplitude,
-        decay_per_s: args.decay,
-        resonance_hz: args.resonance,
-        load_zone: args.load_zone,
-        load_exponent: 1.5,
-        jitter: args.jitter,
-        defect_length_mm: args.defect_length,
-        noise_g: args.noise,
-        shaft_tone_g: 0.05,
-        nuisance: if args.nuisance {
-            Nuisance::typical()
-        } else {
-            Nuisance::none()
-        },
-        onset_s: args.onset,
-        ramp_s: 0.0,
-        seed: args.seed,
+    let samples = match args.model {
+        ModelArg::Signal => {
+            let params = SimulationParams {
+                fault: args.fault.into(),
+                rpm: args.rpm,
+                bearing: bearing.clone(),
+                fs_hz: args.fs,
+                amplitude_g: args.amplitude,
+                decay_per_s: args.decay,
+                resonance_hz: args.resonance,
+                load_zone: args.load_zone,
+                load_exponent: 1.5,
+                jitter: args.jitter,
+                defect_length_mm: args.defect_length,
+                noise_g: args.noise,
+                shaft_tone_g: 0.05,
+                nuisance: if args.nuisance {
+                    Nuisance::typical()
+                } else {
+                    Nuisance::none()
+                },
+                onset_s: args.onset,
+                ramp_s: 0.0,
+                seed: args.seed,
+            };
+            Simulator::record(params, duration)
+        }
+        ModelArg::Physics => simulate_physics(args, bearing, duration)?,
     };
-    let samples = Simulator::record(params, duration);
     let extension = args
         .out
         .extension()
@@ -186,6 +231,73 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         args.bearing
     );
     Ok(())
+}
+
+/// The physics twin's record, block by block with progress on stderr (it takes seconds per
+/// simulated second).
+fn simulate_physics(
+    args: &SimulateArgs,
+    bearing: BearingGeometry,
+    duration: f64,
+) -> Result<Vec<f32>, CliError> {
+    let mut params = match &args.calibrated {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| {
+                CliError::input(format!(
+                    "{}: cannot read the calibrated parameters: {e}",
+                    path.display()
+                ))
+            })?;
+            let mut saved: PhysicsParams = serde_json::from_str(&text).map_err(|e| {
+                CliError::input(format!(
+                    "{}: not a parameter file written by `bearingd calibrate --save`: {e}",
+                    path.display()
+                ))
+            })?;
+            saved.fault = args.fault.into();
+            saved
+        }
+        None => {
+            let mut params = PhysicsParams::new(bearing, args.rpm, args.fault.into());
+            params.load_n = args.load;
+            params.defect_width_mm = args.defect_width;
+            params.dof = args.dof.into();
+            let s = &mut params.structure;
+            s.resonator_stiffness =
+                s.resonator_mass_kg * (std::f64::consts::TAU * args.resonance).powi(2);
+            s.resonator_damping =
+                2.0 * args.damping_ratio * (s.resonator_stiffness * s.resonator_mass_kg).sqrt();
+            params
+        }
+    };
+    params.rpm = args.rpm;
+    params.fs_hz = args.fs;
+    params.duration_s = duration;
+    params.noise_g = args.noise;
+    params.slip = args.jitter;
+    params.seed = args.seed;
+    let total = params.samples();
+    let mut model = PhysicsModel::new(params).map_err(CliError::input)?;
+    let mut samples = vec![0f32; total];
+    // Progress on a terminal only (a log or a pipe gets the one summary line).
+    let show_progress = std::io::stderr().is_terminal();
+    let started = std::time::Instant::now();
+    let block = (args.fs as usize).max(1);
+    for (i, chunk) in samples.chunks_mut(block).enumerate() {
+        model.fill(chunk).map_err(CliError::failure)?;
+        if show_progress {
+            let done = ((i + 1) * block).min(total);
+            eprint!(
+                "\rbearingd: physics twin: {:.1} of {duration} s simulated ({:.1} s elapsed)",
+                done as f64 / args.fs,
+                started.elapsed().as_secs_f64()
+            );
+        }
+    }
+    if show_progress {
+        eprintln!();
+    }
+    Ok(samples)
 }
 
 fn write_wav(path: &PathBuf, fs: f64, samples: &[f32]) -> std::io::Result<()> {

@@ -56,8 +56,8 @@ use std::path::Path;
 
 pub use error::{ConfigError, ConfigProblem};
 pub use types::{
-    CanConfig, Config, OutputConfig, SensorConfig, ShmConfig, SimConfig, SimFault, Speed,
-    ThresholdConfig, Transport, TwinConfig,
+    Broker, CanConfig, Config, FleetConfig, OutputConfig, SensorConfig, ShmConfig, SimConfig,
+    SimFault, Speed, ThresholdConfig, Transport, TwinConfig,
 };
 pub use validate::{MAX_ID_LEN, MAX_IOX_ROOT_LEN};
 

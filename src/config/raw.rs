@@ -61,6 +61,7 @@ pub(crate) struct RawConfig {
     pub twin: RawTwin,
     pub thresholds: RawThresholds,
     pub outputs: RawOutputs,
+    pub fleet: RawFleet,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -165,4 +166,24 @@ pub(crate) struct RawOutputs {
     pub iceoryx2_root: Field<String>,
     pub status_interval_s: Field<f64>,
     pub state_save_interval_s: Field<f64>,
+}
+
+/// `[fleet]`: the fleet bridge over MQTT Sparkplug B.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawFleet {
+    pub enabled: Field<bool>,
+    pub broker: Field<String>,
+    pub group_id: Field<String>,
+    pub node_id: Field<String>,
+    pub client_id: Field<String>,
+    pub username: Field<String>,
+    pub password_file: Field<String>,
+    pub ca_file: Field<String>,
+    pub client_cert_file: Field<String>,
+    pub client_key_file: Field<String>,
+    pub publish_period_s: Field<f64>,
+    pub keep_alive_s: Field<f64>,
+    pub queue_dir: Field<String>,
+    pub queue_max_mb: Field<f64>,
 }

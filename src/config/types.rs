@@ -25,6 +25,8 @@ pub struct Config {
     pub thresholds: ThresholdConfig,
     /// Where results go (`[outputs]`).
     pub outputs: OutputConfig,
+    /// The fleet bridge over MQTT (`[fleet]`); `None` when it is off (the default).
+    pub fleet: Option<FleetConfig>,
 }
 
 impl Config {
@@ -308,3 +310,57 @@ pub(crate) const DEFAULT_BAND_PERIOD_S: f64 = 20.0;
 pub(crate) const DEFAULT_SCALE_G_PER_COUNT: f64 = 0.000488;
 pub(crate) const DEFAULT_AXIS: &str = "radial";
 pub(crate) const DEFAULT_CAN_INTERFACE: &str = "can0";
+
+/// Where the broker is, and whether to speak TLS to it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct Broker {
+    /// `mqtts://`: TLS (rustls).
+    pub tls: bool,
+    pub host: String,
+    pub port: u16,
+}
+
+impl std::fmt::Display for Broker {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let scheme = if self.tls { "mqtts" } else { "mqtt" };
+        write!(f, "{scheme}://{}:{}", self.host, self.port)
+    }
+}
+
+/// The validated `[fleet]` section (present only when `enabled = true`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FleetConfig {
+    pub broker: Broker,
+    /// Sparkplug group id: 1 to 64 of `A-Z a-z 0-9 - _ .`.
+    pub group_id: String,
+    /// Sparkplug edge node id (this box), same characters.
+    pub node_id: String,
+    /// MQTT client id; default `bearingd-<node_id>`.
+    pub client_id: String,
+    pub username: Option<String>,
+    /// A file whose first line is the password (kept out of the config, which is readable by
+    /// all).
+    pub password_file: Option<PathBuf>,
+    /// CA certificates (PEM) to trust for `mqtts://`; without it, the system's roots.
+    pub ca_file: Option<PathBuf>,
+    /// Client certificate chain and key (PEM), for brokers that authenticate clients by
+    /// certificate.
+    pub client_cert_file: Option<PathBuf>,
+    pub client_key_file: Option<PathBuf>,
+    /// Seconds of sample time between two data records of a channel (flag and stage changes go
+    /// at once).
+    pub publish_period_s: f64,
+    /// MQTT keep-alive, in seconds: how soon the broker notices a dead link and sends the
+    /// NDEATH (after 1.5 × this).
+    pub keep_alive_s: f64,
+    /// The store-and-forward queue's directory; default `<state_dir>/fleet`.
+    pub queue_dir: PathBuf,
+    /// The queue's size limit, in MiB; when full, the oldest records are dropped and counted.
+    pub queue_max_mb: f64,
+}
+
+impl FleetConfig {
+    pub fn queue_max_bytes(&self) -> u64 {
+        (self.queue_max_mb * (1u64 << 20) as f64) as u64
+    }
+}

@@ -51,6 +51,9 @@ pub enum DaemonEvent {
         dropped_end_sample: u64,
         total: u64,
     },
+    /// The fleet bridge's notices (connected, broker unreachable or refusing, queue full, its
+    /// summary at the stop), one line each.
+    Fleet(String),
     /// A live source stopped with an error (`source` names it: `CAN source`, `iceoryx2 source
     /// bearingd/accel/<sensor>`).
     SourceStopped { source: String, error: String },

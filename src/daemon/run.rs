@@ -34,17 +34,19 @@
 use super::events::{DaemonEvent, Events};
 use super::lock::{DirLock, LockError};
 use super::state::{load_baselines, save_baselines};
+use crate::clock::wall_clock_now_ns;
 use crate::config::{Config, Transport};
 use crate::mcap_log::McapLogError;
 use crate::messages::{FlagMessage, PipelineMessage, TwinMessage};
 use crate::pipeline::twin_queue::{twin_requests, TwinRequestQueue, TwinRequests};
 use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinWorker};
 use crate::sinks::alerts::PublisherSummary;
+use crate::sinks::fleet::FleetSink;
 use crate::sinks::mcap::McapSink;
 use crate::sinks::systemd::{keep_alive, status_text, Notifier};
 use crate::sources::live::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
 use crate::sources::sim::SimSource;
-use crate::sources::{wall_clock_now_ns, Arrived};
+use crate::sources::Arrived;
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::Duration;
@@ -82,6 +84,8 @@ pub enum RunError {
     #[cfg(feature = "shm")]
     #[error("alerts: {0}")]
     Alerts(#[from] crate::sinks::alerts::AlertError),
+    #[error("fleet bridge: {0}")]
+    Fleet(#[from] crate::sinks::fleet::bridge::BridgeError),
     #[error("cannot start the {what} thread: {source}")]
     ThreadSpawn {
         what: &'static str,
@@ -126,7 +130,12 @@ pub async fn run(
 ) -> Result<RunSummary, RunError> {
     let state_dir = prepare_state_dir(&config)?;
     let _locks = lock_data_dirs(&config, &events)?;
-    sinks.push(Box::new(open_log(&config, &events)?));
+    // Wall time of sample 0: the log's time base, and the fleet bridge's.
+    let origin_ns = wall_clock_now_ns();
+    sinks.push(Box::new(open_log(&config, origin_ns, &events)?));
+    if let Some(fleet) = start_fleet(&config, origin_ns, &events)? {
+        sinks.push(Box::new(fleet));
+    }
     let alerts = start_alerts(&config, &events)?;
     let (baselines, loaded) = load_baselines(&state_dir);
     match loaded {
@@ -242,8 +251,8 @@ fn lock_data_dirs(config: &Config, events: &Events) -> Result<Vec<DirLock>, RunE
 }
 
 /// Recovers what a crash left in the log directory and opens the log, sample 0 at now.
-fn open_log(config: &Config, events: &Events) -> Result<McapSink, RunError> {
-    let (log, recovered) = McapSink::for_config(config, wall_clock_now_ns())?;
+fn open_log(config: &Config, origin_ns: u64, events: &Events) -> Result<McapSink, RunError> {
+    let (log, recovered) = McapSink::for_config(config, origin_ns)?;
     let log = {
         let events = events.clone();
         log.on_retention(move |report| events(DaemonEvent::Retention(report.clone())))
@@ -255,6 +264,17 @@ fn open_log(config: &Config, events: &Events) -> Result<McapSink, RunError> {
         events(DaemonEvent::LoggingTo(path.to_path_buf()));
     }
     Ok(log)
+}
+
+/// The fleet bridge of `[fleet]`, when it is on; its notices become [`DaemonEvent::Fleet`].
+fn start_fleet(
+    config: &Config,
+    origin_ns: u64,
+    events: &Events,
+) -> Result<Option<FleetSink>, RunError> {
+    let events = events.clone();
+    let notices = std::sync::Arc::new(move |line| events(DaemonEvent::Fleet(line)));
+    Ok(FleetSink::start(config, origin_ns, notices)?)
 }
 
 /// The alert service `outputs.alerts_service` under `outputs.iceoryx2_root`.

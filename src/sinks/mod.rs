@@ -5,6 +5,8 @@
 //!   the subscriber that `bearingd alerts` uses.
 //! - [`systemd`]: the notify protocol (READY, STATUS, WATCHDOG, STOPPING) and the one-line
 //!   `STATUS=`.
+//! - [`fleet`]: the fleet bridge, MQTT Sparkplug B with store-and-forward, as a [`Sink`] whose
+//!   network and fsyncs run on a thread of their own.
 //!
 //! Every sink is blocking by design (files, compression, iceoryx2 ports) and runs on a thread of
 //! its own behind a bounded queue; the daemon decides which thread (`crate::daemon`).
@@ -12,5 +14,6 @@
 //! [`Sink`]: crate::pipeline::Sink
 
 pub mod alerts;
+pub mod fleet;
 pub mod mcap;
 pub mod systemd;

@@ -119,7 +119,7 @@ impl Arrived {
     pub fn now(input: Input) -> Arrived {
         Arrived {
             input,
-            wall_ns: super::wall_clock_now_ns(),
+            wall_ns: crate::clock::wall_clock_now_ns(),
         }
     }
 }

@@ -4,7 +4,7 @@
 //!   events onto the config's channels for `bearingd run`.
 //! - [`sim`]: the in-process simulated sensor node (the twin's signal model).
 //! - [`replay`]: the raw samples and measured speeds of MCAP logs.
-//! - [`Arrived`] and [`wall_clock_now_ns`]: the one wall-clock reading on the way in.
+//! - [`Arrived`]: an input with the wall-clock time it arrived ([`crate::clock`]).
 //!
 //! Why this module exists apart from the analysis core: the core is sans-IO (no socket, no
 //! clock, no async runtime), so something must own the sockets, the shared memory, the
@@ -123,14 +123,4 @@ impl StatsTimer {
             None => std::future::pending().await,
         }
     }
-}
-
-/// The system clock in nanoseconds since the Unix epoch, for the edges of the daemon (an
-/// input's arrival, the log's origin, an alert's run id); never called by the analysis, the
-/// pipeline or the log writer.
-pub fn wall_clock_now_ns() -> u64 {
-    std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX))
-        .unwrap_or(0)
 }

@@ -1,11 +1,14 @@
 //! The signal-model digital twin of the bearing (MODELS.md §4): a simulator of a localized
 //! defect's vibration, shared by every part that needs a synthetic signal; the same model's
 //! envelope spectrum in closed form; and its fit to measured spectra, per fault hypothesis.
+//! The physics twin (MODELS.md §5, [`physics`]): the 6-DOF contact model and its calibration.
 
 pub mod diagnose;
 pub mod fit;
+pub mod hw;
 pub mod model;
 pub mod optimize;
+pub mod physics;
 pub mod simulate;
 
 pub use fit::{FitBounds, HypothesisFit, TwinFitter, TwinParams};

@@ -23,10 +23,10 @@
 use crate::bearing::{BearingGeometry, FaultFrequencies, Race};
 use crate::messages::FaultKind;
 use crate::random::Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Which defect the simulated bearing has.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SimulatedFault {
     None,

@@ -5,14 +5,14 @@ use bearingd_testdata::{scratch_dir, shared_data_dir};
 use std::path::Path;
 use std::process::{Command, Output};
 
-fn bearingd(args: &[&str]) -> Output {
+pub fn bearingd(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_bearingd"))
         .args(args)
         .output()
         .expect("run bearingd")
 }
 
-fn stderr(out: &Output) -> String {
+pub fn stderr(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 

@@ -121,6 +121,18 @@ pub fn python_scipy() -> Option<PathBuf> {
     )
 }
 
+/// The project's Python with `paho-mqtt` and `protobuf`, for the Sparkplug B host of the fleet
+/// bridge's tests (`tests/python/sparkplug_subscriber.py`).
+///
+/// # Panics
+/// Under `CI=true` when it is missing (tests only).
+pub fn python_sparkplug() -> Option<PathBuf> {
+    venv_python(
+        "import paho.mqtt.client, google.protobuf",
+        "the Python MQTT client and protobuf (paho-mqtt, protobuf)",
+    )
+}
+
 fn venv_python(imports: &str, what: &str) -> Option<PathBuf> {
     let py = repo_root().join(".venv/bin/python");
     let ci = std::env::var("CI").is_ok_and(|v| v == "true");

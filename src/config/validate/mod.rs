@@ -5,6 +5,7 @@
 //! second. Each message ends with how to fix it; the hints live next to the checks.
 
 mod analysis;
+mod fleet;
 mod outputs;
 mod sensors;
 mod thresholds;
@@ -49,15 +50,17 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
     let twin = check.twin(&raw.twin);
     let thresholds = check.thresholds(&raw.thresholds);
     let outputs = check.outputs(&raw.outputs, &sensors);
+    let fleet = check.fleet(&raw.fleet, outputs.as_ref().map(|o| o.state_dir.as_path()));
 
     let sensors: Option<Vec<SensorConfig>> = sensors.into_iter().map(|s| s.config).collect();
-    match (sensors, analysis, twin, thresholds, outputs) {
+    match (sensors, analysis, twin, thresholds, outputs, fleet) {
         (
             Some(sensors),
             Some((analysis, band_period_s)),
             Some(twin),
             Some(thresholds),
             Some(outputs),
+            Some(fleet),
         ) if check.problems.is_empty() => Ok(Config {
             sensors,
             analysis,
@@ -65,6 +68,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
             twin,
             thresholds,
             outputs,
+            fleet,
         }),
         _ => {
             if check.problems.is_empty() {

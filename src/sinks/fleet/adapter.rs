@@ -1,0 +1,193 @@
+//! The seam between the daemon and the bridge: the only file of `sinks::fleet` that knows the
+//! daemon's message types and its `Sink` trait (so that moving them, e.g. to `messages.rs` and
+//! `pipeline/`, touches this file alone).
+//!
+//! On the daemon's sink thread it turns each [`PipelineMessage`] into an [`Observation`]: the
+//! channel becomes a device index, the sample position a time in milliseconds since the epoch
+//! (`origin + sample / fs`, the mapping of the MCAP log), and a flag change gets the
+//! confidence the alert service would give it (the same [`AlertTracker`] rule). Raw samples,
+//! spectra, speed frames' bookkeeping and ingest counters do not leave the box.
+
+use super::bridge::{self, BridgeError, BridgeHandle, Notices};
+use super::metrics::{device_id, Observation, Observed};
+use crate::config::Config;
+use crate::messages::{ChannelId, HealthKind, PipelineMessage};
+use crate::pipeline::{Sink, SinkError};
+use crate::sinks::alerts::{AlertState, AlertTracker};
+use std::collections::HashMap;
+
+/// The fleet bridge as a sink of `bearingd run`.
+pub struct FleetSink {
+    handle: Option<BridgeHandle>,
+    channels: HashMap<ChannelId, usize>,
+    rates: HashMap<String, f64>,
+    origin_ns: u64,
+    tracker: AlertTracker,
+    /// The bridge thread is gone (said once).
+    gone: bool,
+    notices: Notices,
+}
+
+impl FleetSink {
+    /// Starts the bridge of `config.fleet`; `None` when the bridge is off. `origin_ns`: the
+    /// wall time of sample 0 (the MCAP log's origin); `notices`: where the bridge's notices go.
+    pub fn start(
+        config: &Config,
+        origin_ns: u64,
+        notices: Notices,
+    ) -> Result<Option<FleetSink>, BridgeError> {
+        let Some(fleet) = config.fleet.clone() else {
+            return Ok(None);
+        };
+        let mut channels = HashMap::new();
+        let mut devices = Vec::new();
+        for sensor in &config.sensors {
+            for axis in &sensor.axes {
+                let id = ChannelId {
+                    sensor: sensor.id.clone(),
+                    axis: axis.clone(),
+                };
+                channels.insert(id, devices.len());
+                devices.push(device_id(&sensor.id, axis));
+            }
+        }
+        let rates: HashMap<String, f64> = config
+            .sensors
+            .iter()
+            .map(|s| (s.id.clone(), s.sample_rate_hz))
+            .collect();
+        notices(format!(
+            "fleet: publishing {} channel(s) to {} as spBv1.0/{}/…/{} (queue {})",
+            devices.len(),
+            fleet.broker,
+            fleet.group_id,
+            fleet.node_id,
+            fleet.queue_dir.display()
+        ));
+        let handle = bridge::start(fleet, devices, notices.clone())?;
+        // The tracker's history size only matters for iceoryx2 repeats, which are ignored here.
+        let tracker = AlertTracker::new(origin_ns, 16, &config.analysis, rates.clone());
+        Ok(Some(FleetSink {
+            handle: Some(handle),
+            channels,
+            rates,
+            origin_ns,
+            tracker,
+            gone: false,
+            notices,
+        }))
+    }
+
+    fn at_ms(&self, channel: &ChannelId, sample: u64) -> u64 {
+        let fs = self.rates.get(&channel.sensor).copied().unwrap_or(1.0);
+        (self.origin_ns + (sample as f64 / fs * 1e9) as u64) / 1_000_000
+    }
+
+    fn observation(&mut self, message: &PipelineMessage) -> Option<Observation> {
+        let (channel, sample, what) = match message {
+            PipelineMessage::Indicators(m) => (
+                &m.channel,
+                m.end_sample,
+                Observed::Window {
+                    rpm: m.rpm.is_finite().then_some(m.rpm),
+                    rms_g: m.rms,
+                    peak_g: m.peak,
+                    crest: m.crest,
+                    kurtosis: m.kurtosis,
+                    scores: [
+                        m.score_outer_race,
+                        m.score_inner_race,
+                        m.score_ball,
+                        m.score_cage,
+                    ],
+                },
+            ),
+            PipelineMessage::Flag(m) => {
+                let mut confidence = f64::NAN;
+                self.tracker.observe(message, 0, &mut |alert| {
+                    if alert.state != AlertState::Repeated as u8 {
+                        confidence = alert.confidence;
+                    }
+                });
+                (
+                    &m.channel,
+                    m.end_sample,
+                    Observed::Flag {
+                        fault: m.fault,
+                        level: m.to,
+                        score: m.score,
+                        confidence,
+                    },
+                )
+            }
+            PipelineMessage::Health(m) => {
+                let what = match (m.kind, m.stage) {
+                    (HealthKind::Stage, Some(stage)) => Observed::Stage(stage),
+                    (HealthKind::Lost, _) => Observed::SensorLost(true),
+                    (HealthKind::Back, _) => Observed::SensorLost(false),
+                    _ => return None,
+                };
+                (&m.channel, m.end_sample, what)
+            }
+            PipelineMessage::Twin(m) => {
+                self.tracker.note_twin(m);
+                (
+                    &m.channel,
+                    m.end_sample,
+                    Observed::Twin {
+                        hypothesis: m.hypothesis,
+                        error: m.error,
+                        margin: m.margin,
+                        errors: [m.error_outer_race, m.error_inner_race, m.error_ball],
+                        residual_energy_ratio: m.residual_energy_ratio,
+                        residual_peak_hz: m.residual_peak_hz,
+                    },
+                )
+            }
+            PipelineMessage::Speed(m) => (&m.channel, m.end_sample, Observed::Speed(m.rpm)),
+            // The ISO 20816 zone has a metric slot (`ISO20816/Zone`); it is filled from
+            // `Observed::IsoZone` once the pipeline emits zones.
+            PipelineMessage::Raw(_) | PipelineMessage::Spectrum(_) | PipelineMessage::Ingest(_) => {
+                return None
+            }
+        };
+        if let PipelineMessage::Indicators(_) = message {
+            // The tracker needs every window's scores for the confidence of the next flag.
+            self.tracker.observe(message, 0, &mut |_| {});
+        }
+        Some(Observation {
+            device: *self.channels.get(channel)?,
+            at_ms: self.at_ms(channel, sample),
+            what,
+        })
+    }
+}
+
+impl Sink for FleetSink {
+    fn write(&mut self, message: &PipelineMessage) {
+        let Some(observation) = self.observation(message) else {
+            return;
+        };
+        let Some(handle) = self.handle.as_ref() else {
+            return;
+        };
+        if handle.intake.blocking_send(observation).is_err() && !self.gone {
+            self.gone = true;
+            (self.notices)(
+                "fleet: the bridge thread has stopped; nothing more is published".into(),
+            );
+        }
+    }
+
+    fn finish(&mut self) -> Result<(), SinkError> {
+        let Some(handle) = self.handle.take() else {
+            return Ok(());
+        };
+        drop(handle.intake);
+        handle.thread.join().map(|_| ()).map_err(|_| SinkError {
+            sink: "fleet bridge",
+            count: 1,
+            first: "the bridge thread panicked".into(),
+        })
+    }
+}

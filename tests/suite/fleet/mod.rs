@@ -1,0 +1,409 @@
+//! The fleet bridge against a real broker (issue 15): `bearingd run` processes publishing to a
+//! mosquitto started by the test (TLS, passwords, client certificates, an ACL), checked by a
+//! Python Sparkplug B host (`tests/python/sparkplug_subscriber.py`: paho-mqtt, protobuf from
+//! `proto/sparkplug_b.proto`).
+//!
+//! The slow cases (a 60 s outage in real time) run beside the others: every test has its own
+//! broker on its own ports, its own node processes and scratch directory.
+
+mod broker;
+mod host;
+mod node;
+
+use broker::{Mosquitto, GROUP, NODES};
+use host::Host;
+use node::{NodeProcess, NodeSetup};
+use serde_json::Value;
+use std::time::{Duration, Instant};
+
+fn metric<'a>(message: &'a Value, name: &str) -> Option<&'a Value> {
+    message["metrics"].get(name).map(|m| &m["value"])
+}
+
+fn of_type<'a>(messages: &'a [Value], kind: &str) -> Vec<&'a Value> {
+    messages.iter().filter(|m| m["type"] == kind).collect()
+}
+
+/// The bdSeq of every NBIRTH of `node`, in order.
+fn births_of(summary: &Value, node: &str) -> Vec<u64> {
+    summary["births"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|b| b[0] == node)
+        .filter_map(|b| b[1].as_u64())
+        .collect()
+}
+
+fn assert_no_violations(summary: &Value) {
+    assert_eq!(
+        summary["violations"],
+        serde_json::json!([]),
+        "Sparkplug rules broken; summary: {}",
+        summary["counts"]
+    );
+}
+
+#[test]
+fn birth_data_rebirth_and_death_on_kill_9_then_a_restart_and_a_clean_stop() {
+    let Some(setup) = NodeSetup::prepare("fleet-life") else {
+        return;
+    };
+    let broker = Mosquitto::start(&setup.dir);
+    let host = Host::start(&broker, &setup.dir, 3);
+    let config = setup.config(&broker, &NODES[0], |_| {});
+    let mut node = NodeProcess::start(&setup, &config, &[]);
+
+    // Births, data, the rebirth asked for after 3 DDATA, and a raised flag with its confidence.
+    let messages = host.wait_for("a second NBIRTH (rebirth) and a raised flag", 120, |m| {
+        of_type(m, "NBIRTH").len() >= 2
+            && m.iter().any(|x| {
+                x["type"] == "DDATA"
+                    && metric(x, "Fault/outer_race/Flag").is_some_and(|f| f != "ok")
+            })
+    });
+    let nbirth = of_type(&messages, "NBIRTH")[0];
+    assert_eq!(nbirth["topic"], format!("spBv1.0/{GROUP}/NBIRTH/press-7"));
+    assert_eq!(nbirth["seq"], 0);
+    let dbirth = of_type(&messages, "DBIRTH")[0];
+    assert_eq!(
+        dbirth["topic"],
+        format!("spBv1.0/{GROUP}/DBIRTH/press-7/motor-de.radial")
+    );
+    for name in [
+        "Sensor/Lost",
+        "Health/Stage",
+        "Speed/RPM",
+        "Vibration/RMS_g",
+        "Vibration/Kurtosis",
+        "ISO20816/Zone",
+        "Twin/Error",
+        "Fault/outer_race/Flag",
+        "Fault/outer_race/Confidence",
+        "Fault/inner_race/Score",
+        "Fault/ball/Score",
+        "Fault/cage/Score",
+    ] {
+        assert!(
+            dbirth["metrics"].get(name).is_some(),
+            "DBIRTH lacks {name}: {dbirth}"
+        );
+    }
+    let data = of_type(&messages, "DDATA");
+    let rms: Vec<f64> = data
+        .iter()
+        .filter_map(|d| metric(d, "Vibration/RMS_g")?.as_f64())
+        .collect();
+    assert!(
+        rms.len() >= 3 && rms.iter().all(|r| *r > 0.0 && *r < 100.0),
+        "{rms:?}"
+    );
+    let raised = data
+        .iter()
+        .find(|d| metric(d, "Fault/outer_race/Flag").is_some_and(|f| f != "ok"))
+        .unwrap();
+    let confidence = metric(raised, "Fault/outer_race/Confidence")
+        .and_then(Value::as_f64)
+        .unwrap_or(f64::NAN);
+    assert!(confidence > 0.0 && confidence <= 1.0, "{raised}");
+    assert!(
+        metric(raised, "Fault/outer_race/Score")
+            .and_then(Value::as_f64)
+            .is_some(),
+        "{raised}"
+    );
+    // DDATA every publish period of sample time (1 s), and at once on the flag change.
+    let stamps: Vec<u64> = data
+        .iter()
+        .filter(|d| d["device"] == "motor-de.radial")
+        .filter_map(|d| d["timestamp"].as_u64())
+        .collect();
+    assert!(stamps.windows(2).all(|w| w[1] >= w[0]), "{stamps:?}");
+
+    // kill -9: the broker publishes the Will, the NDEATH of this session's bdSeq.
+    node.kill_9();
+    let messages = host.wait_for("the NDEATH (Will) after kill -9", 60, |m| {
+        !of_type(m, "NDEATH").is_empty()
+    });
+    let death = of_type(&messages, "NDEATH")[0];
+    assert_eq!(metric(death, "bdSeq"), metric(nbirth, "bdSeq"));
+
+    // A restart: the next bdSeq, then a clean stop: DDEATH and NDEATH.
+    let node = NodeProcess::start(&setup, &config, &[]);
+    host.wait_for("a third NBIRTH after the restart and data", 60, |m| {
+        of_type(m, "NBIRTH").len() >= 3
+            && m.iter()
+                .rev()
+                .take_while(|x| x["type"] != "NBIRTH")
+                .any(|x| x["type"] == "DDATA")
+    });
+    let stopped = node.terminate();
+    assert!(stopped.success, "{}", stopped.stderr);
+    assert!(
+        stopped.stderr.contains("left in the queue") && stopped.stderr.contains("0 dropped"),
+        "{}",
+        stopped.stderr
+    );
+    let messages = host.wait_for("the DDEATH and NDEATH of the clean stop", 30, |m| {
+        of_type(m, "NDEATH").len() >= 2
+    });
+    assert!(!of_type(&messages, "DDEATH").is_empty());
+
+    let summary = host.finish();
+    assert_no_violations(&summary);
+    let births = births_of(&summary, "press-7");
+    assert_eq!(births.len(), 3, "{}", summary["births"]);
+    assert_eq!(births[1], births[0], "a rebirth keeps the bdSeq");
+    assert_eq!(
+        births[2],
+        (births[0] + 1) % 256,
+        "a new process, the next bdSeq"
+    );
+    let deaths = summary["deaths"].as_array().unwrap();
+    assert_eq!(deaths.len(), 2, "{deaths:?}");
+    assert!(
+        deaths.iter().all(|d| d[2] == true),
+        "each NDEATH carries its session's bdSeq: {deaths:?}"
+    );
+    // Across the kill, nothing the queue held is missing.
+    let records = &summary["records"];
+    assert_eq!(records["first"], 0, "{records}");
+    assert_eq!(records["missing"], serde_json::json!([]), "{records}");
+    assert_eq!(records["out_of_order"], serde_json::json!([]), "{records}");
+    drop(broker);
+}
+
+#[test]
+fn a_wrong_password_a_foreign_node_id_and_a_wrong_ca_are_refused_and_said_clearly() {
+    let Some(setup) = NodeSetup::prepare("fleet-security") else {
+        return;
+    };
+    let broker = Mosquitto::start(&setup.dir);
+    let host = Host::start(&broker, &setup.dir, 0);
+    let [press7, press8] = &NODES;
+
+    let wrong_password = setup.config(&broker, press7, |c| {
+        c.password = "not-the-password".into();
+        c.name = "wrong-password".into();
+    });
+    // press-8's user publishing as node press-7: the ACL allows it its own node id only.
+    let foreign_node = setup.config(&broker, press8, |c| {
+        c.node_id = "press-7".into();
+        c.name = "foreign-node".into();
+    });
+    let wrong_ca = setup.config(&broker, press7, |c| {
+        c.ca_file = broker.dir.join("other-ca.pem");
+        c.name = "wrong-ca".into();
+    });
+    // A node authenticated by its client certificate (CN press-9) on the second listener.
+    let by_certificate = setup.config(&broker, press7, |c| {
+        c.node_id = broker.client_cn.clone();
+        c.port = broker.cert_port;
+        c.username = None;
+        c.client_cert = Some((broker.dir.join("client.pem"), broker.dir.join("client.key")));
+        c.name = "certificate".into();
+    });
+    let nodes: Vec<NodeProcess> = [&wrong_password, &foreign_node, &wrong_ca, &by_certificate]
+        .into_iter()
+        .map(|c| NodeProcess::start(&setup, c, &[]))
+        .collect();
+
+    let expectations = [
+        (
+            &nodes[0],
+            vec![
+                "REFUSED the connection",
+                "fleet.username (press-7)",
+                "fleet.password_file",
+            ],
+        ),
+        (&nodes[1], vec!["REFUSED", "ACL", "fleet.node_id"]),
+        (&nodes[2], vec!["TLS failed", "fleet.ca_file"]),
+    ];
+    for (node, phrases) in &expectations {
+        node.wait_for_stderr(&phrases.join(" + "), 60, |text| {
+            phrases.iter().all(|p| text.contains(p))
+        });
+    }
+    let messages = host.wait_for("the certificate node's birth and data", 60, |m| {
+        m.iter()
+            .any(|x| x["type"] == "DDATA" && x["node"] == broker.client_cn.as_str())
+    });
+    for node in nodes {
+        let out = node.terminate();
+        assert!(out.success, "{}", out.stderr);
+    }
+    let summary = host.finish();
+    assert_no_violations(&summary);
+    assert!(
+        messages
+            .iter()
+            .all(|m| m["node"] == broker.client_cn.as_str()),
+        "only the certificate node got through: {:?}",
+        messages.iter().map(|m| &m["topic"]).collect::<Vec<_>>()
+    );
+    let log = broker.log();
+    assert!(
+        log.contains("not authorised") || log.contains("Denied PUBLISH"),
+        "{log}"
+    );
+}
+
+#[test]
+fn store_and_forward_through_a_broker_restart_a_60_s_outage_and_a_kill_9() {
+    let Some(setup) = NodeSetup::prepare("fleet-outage") else {
+        return;
+    };
+    let mut broker = Mosquitto::start(&setup.dir);
+    let host = Host::start(&broker, &setup.dir, 0);
+    let config = setup.config(&broker, &NODES[0], |_| {});
+    let mut node = NodeProcess::start(&setup, &config, &[]);
+    let records_seen = |m: &[Value]| of_type(m, "DDATA").len();
+
+    host.wait_for("5 DDATA", 60, |m| records_seen(m) >= 5);
+    // The broker restarted mid-run.
+    broker.down();
+    broker.up();
+    let before = records_seen(&host.messages());
+    host.wait_for("5 more DDATA after the broker's restart", 60, |m| {
+        records_seen(m) >= before + 5
+    });
+
+    // Down for 60 s of (real-time) simulated data; the node is killed half-way and restarted.
+    broker.down();
+    let down_ms = host::now_ms();
+    std::thread::sleep(Duration::from_secs(30));
+    node.kill_9();
+    let node = NodeProcess::start(&setup, &config, &[]);
+    std::thread::sleep(Duration::from_secs(30));
+    broker.up();
+    let up_ms = host::now_ms();
+    let restarted = node.wait_for_stderr("the records from before the restart", 10, |t| {
+        t.contains("records from before the restart wait")
+    });
+    assert!(restarted.contains("wait in"), "{restarted}");
+
+    // The backlog goes first, in order; then live data again.
+    host.wait_for("a live DDATA after the backlog", 90, |m| {
+        m.iter().any(|x| {
+            x["type"] == "DDATA"
+                && x["received_ms"].as_u64() > Some(up_ms)
+                && x["timestamp"].as_u64() > Some(up_ms)
+        })
+    });
+    let stopped = node.terminate();
+    assert!(stopped.success, "{}", stopped.stderr);
+    let summary = host.finish();
+    assert_no_violations(&summary);
+    let records = &summary["records"];
+    assert_eq!(records["first"], 0, "{records}");
+    assert_eq!(
+        records["missing"],
+        serde_json::json!([]),
+        "records lost: {records}"
+    );
+    assert_eq!(records["out_of_order"], serde_json::json!([]), "{records}");
+    let list = summary["record_list"].as_array().unwrap();
+    let during_outage: Vec<&Value> = list
+        .iter()
+        .filter(|r| {
+            let t = r["timestamp"].as_u64().unwrap();
+            t > down_ms + 1000 && t < up_ms - 1000
+        })
+        .collect();
+    // A record at the first window hop (0.64 s here) at least 1 s after the previous one: one
+    // per 1.28 s, 47 in 60 s, less the seconds the restarted node spent starting and filling
+    // its first window.
+    assert!(
+        during_outage.len() >= 38,
+        "{} records of the 60 s outage arrived: {records}",
+        during_outage.len()
+    );
+    for r in &during_outage {
+        assert_eq!(r["historical"], true, "{r}");
+        assert!(
+            r["received_ms"].as_u64() >= Some(up_ms),
+            "sent after the broker came back, with its original time: {r}"
+        );
+    }
+    let stamps: Vec<u64> = during_outage
+        .iter()
+        .map(|r| r["timestamp"].as_u64().unwrap())
+        .collect();
+    let gaps: Vec<u64> = stamps.windows(2).map(|w| w[1] - w[0]).collect();
+    let long_gaps = gaps.iter().filter(|g| **g > 2000).count();
+    assert!(
+        long_gaps <= 1,
+        "only the kill -9 and restart may leave a gap in the data: {gaps:?}"
+    );
+}
+
+#[test]
+fn a_full_queue_drops_the_oldest_counts_them_and_sends_the_rest_in_order() {
+    let Some(setup) = NodeSetup::prepare("fleet-full") else {
+        return;
+    };
+    let mut broker = Mosquitto::start(&setup.dir);
+    broker.down();
+    let config = setup.config(&broker, &NODES[0], |c| c.queue_max_mb = 0.02);
+    // 300 s of sample time, as fast as the analysis goes, while the broker is down.
+    let first = NodeProcess::start(&setup, &config, &["--fast", "--duration", "300"]).wait(120);
+    assert!(first.success, "{}", first.stderr);
+    assert!(first.stderr.contains("queue full"), "{}", first.stderr);
+    let dropped = summary_count(&first.stderr, " dropped (queue full)");
+    let left = summary_count(&first.stderr, " left in the queue");
+    assert!(dropped > 100, "{}", first.stderr);
+    assert!(left > 5, "{}", first.stderr);
+
+    broker.up();
+    let host = Host::start(&broker, &setup.dir, 0);
+    let started = Instant::now();
+    let second = NodeProcess::start(&setup, &config, &["--fast", "--duration", "5"]).wait(60);
+    assert!(second.success, "{}", second.stderr);
+    assert!(
+        second
+            .stderr
+            .contains(&format!("{left} records from before the restart wait")),
+        "{}",
+        second.stderr
+    );
+    host.wait_for("the queued records", 30, |m| {
+        of_type(m, "DDATA").len() as u64 >= left
+    });
+    let summary = host.finish();
+    assert_no_violations(&summary);
+    let records = &summary["records"];
+    // The oldest were dropped: what arrives starts right after them, without a hole.
+    assert_eq!(records["first"], dropped, "{records}");
+    assert_eq!(records["missing"], serde_json::json!([]), "{records}");
+    // In time order within each run; `--fast` maps 300 s of sample time from the first run's
+    // start, so the second run's first record (number dropped + left) is stamped before the
+    // first run's last ones.
+    let order = records["out_of_order"].as_array().unwrap();
+    assert!(
+        order.is_empty() || order == &[serde_json::json!(dropped + left)],
+        "{records}"
+    );
+    assert!(records["historical"].as_u64() >= Some(left), "{records}");
+    eprintln!(
+        "full queue: {dropped} dropped, {left} kept and delivered in {:.1} s",
+        started.elapsed().as_secs_f64()
+    );
+}
+
+/// The number before `what` in the bridge's summary line.
+fn summary_count(stderr: &str, what: &str) -> u64 {
+    let line = stderr
+        .lines()
+        .rev()
+        .find(|l| l.contains("records made"))
+        .unwrap_or_else(|| panic!("no fleet summary in {stderr}"));
+    let before = &line[..line
+        .find(what)
+        .unwrap_or_else(|| panic!("no {what:?} in {line}"))];
+    before
+        .rsplit(|c: char| !c.is_ascii_digit())
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no number before {what:?} in {line}"))
+}
