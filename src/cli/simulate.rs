@@ -28,6 +28,7 @@ impl From<FaultArg> for SimulatedFault {
             FaultArg::Outer => SimulatedFault::OuterRace,
             FaultArg::Inner => SimulatedFault::InnerRace,
             FaultArg::Ball => SimulatedFault::Ball,
+            FaultArg::Cage => SimulatedFault::Cage,
         }
     }
 }

@@ -11,9 +11,9 @@
 //! process that did not stop cleanly (a `kill -9`, a power cut): it is taken over, and the
 //! caller is told whose it was. A clean stop empties the file, so the next start says nothing.
 
+use crate::clock::wall_clock_now_ns;
 use crate::mcap_log::files::utc_text;
 use crate::sinks::mcap::metadata::host_name;
-use crate::sources::wall_clock_now_ns;
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};

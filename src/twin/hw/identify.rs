@@ -412,8 +412,8 @@ fn levenberg_marquardt(model: &mut HwModel, y: &[f64], u: &[Vec<f64>], config: &
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::twin::hw::linear::monic_from_roots;
     use crate::random::Rng;
+    use crate::twin::hw::linear::monic_from_roots;
     use nalgebra::Complex;
 
     /// Poles of each of the three inputs' blocks: one real pole and a complex pair each.

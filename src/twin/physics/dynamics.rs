@@ -173,7 +173,8 @@ impl Dynamics {
         let angle = params.defect_angle_deg.to_radians();
         let load_line = -FRAC_PI_2;
         let defect = match params.fault {
-            SimulatedFault::None => Defect::None,
+            // `PhysicsParams::validate` refuses a cage fault before a model is built.
+            SimulatedFault::None | SimulatedFault::Cage => Defect::None,
             SimulatedFault::OuterRace => Defect::Outer {
                 centre: load_line + angle,
                 half_width: width / (2.0 * r_outer),

@@ -203,6 +203,12 @@ impl PhysicsParams {
             }
         };
         let positive = |v: f64| v.is_finite() && v > 0.0;
+        check(
+            self.fault != crate::twin::SimulatedFault::Cage,
+            "the physics twin has no damaged-cage model (a cage pocket is not a race or ball \
+             defect it can integrate); simulate a cage fault with the signal model (--model signal)"
+                .to_string(),
+        );
         let g = &self.bearing;
         check(
             g.rolling_elements >= 3
