@@ -399,7 +399,7 @@ mod tests {
         let d = verdict([(1.2, 0.5), (3.5, 4.0), (1.2, 1.0), (1.1, 0.2)]);
         assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
         // Below the lone floor: no.
-        let d = verdict([(1.0, 0.0), (2.9, 30.0), (1.0, 0.0), (1.0, 0.0)]);
+        let d = verdict([(1.0, 0.0), (2.4, 30.0), (1.0, 0.0), (1.0, 0.0)]);
         assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
     }
 

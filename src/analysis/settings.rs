@@ -79,7 +79,7 @@ impl Default for AnalysisSettings {
             false_alarm_rate: 1e-3,
             min_fault_score: 5.0,
             min_score_ratio: 1.5,
-            lone_fault_score: 3.0,
+            lone_fault_score: 2.5,
             lone_score_ratio: 2.0,
         }
     }

@@ -96,7 +96,7 @@ impl Checker {
             d.lone_fault_score,
             Limits::within(1.0, f64::INFINITY),
             "give the smallest comb score (at least 1) that makes a diagnosis when no other \
-             fault comes near it, e.g. lone_fault_score = 3.0",
+             fault comes near it, e.g. lone_fault_score = 2.5",
         );
         let lone_score_ratio = self.number(
             "analysis.lone_score_ratio",
