@@ -261,11 +261,10 @@ pub fn render_tables(summary: &Summary) -> String {
         let columns: Vec<Predicted> = Predicted::COLUMNS
             .into_iter()
             .filter(|c| {
-                let possible = match (p.path, c) {
-                    (Path::Record, Predicted::Several) => false,
-                    (Path::Monitor, Predicted::Ambiguous) => false,
-                    _ => true,
-                };
+                let possible = !matches!(
+                    (p.path, c),
+                    (Path::Record, Predicted::Several) | (Path::Monitor, Predicted::Ambiguous)
+                );
                 possible
                     || p.confusion
                         .values()

@@ -34,6 +34,10 @@ impl Machine {
 
     /// The IMS rig: Rexnord ZA-2115 (16 rollers, contact angle 15.17°) at 2000 rpm, 20.48 kHz;
     /// resonance 4 kHz (choice).
+    #[allow(
+        clippy::expect_used,
+        reason = "a catalog entry; the catalog tests check it exists"
+    )]
     pub fn ims() -> Self {
         Machine {
             bearing: BearingGeometry::from_catalog("rexnord-za-2115").expect("catalog entry"),
@@ -47,6 +51,10 @@ impl Machine {
     /// 25.6 kHz, resonance 5 kHz (choice). A hard case on purpose: its BPFI (7.375 × fr) and
     /// 2·BSF (7.294 × fr) lie 1.1 % apart, inside the ±2 % slip tolerance, so only the
     /// sidebands (±fr against ±FTF) can tell an inner-race from a ball fault.
+    #[allow(
+        clippy::expect_used,
+        reason = "a catalog entry; the catalog tests check it exists"
+    )]
     pub fn siegen() -> Self {
         Machine {
             bearing: BearingGeometry::from_catalog("skf-61804").expect("catalog entry"),
