@@ -6,7 +6,7 @@
 
 use bearingd::mcap_log::read_messages;
 use bearingd::messages::PipelineMessage;
-use bearingd_testdata::{check_mcap_with_python, python_mcap, scratch_dir};
+use bearingd_testdata::{check_mcap_with_python, mcap_files, python_mcap, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -39,19 +39,6 @@ fn start_daemon(data: &Path) -> Child {
         .stderr(Stdio::piped())
         .spawn()
         .unwrap()
-}
-
-fn mcap_files(dir: &Path) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|entries| {
-            entries
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
-                .collect()
-        })
-        .unwrap_or_default();
-    files.sort();
-    files
 }
 
 /// Waits until the daemon's log file holds at least `bytes` (its first flushes are on disk).

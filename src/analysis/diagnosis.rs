@@ -101,6 +101,11 @@ impl DecisionRule {
         score.significance >= self.min_significance()
     }
 
+    /// Significant at `false_alarm_rate²`: the stronger proof a weaker comb needs.
+    fn strongly_significant(&self, score: &FaultScore) -> bool {
+        score.significance >= 2.0 * self.min_significance()
+    }
+
     /// Significant and large enough to name whatever else the spectrum holds.
     pub fn detected(&self, score: &FaultScore) -> bool {
         self.significant(score) && score.score >= self.min_fault_score
@@ -109,7 +114,7 @@ impl DecisionRule {
     /// Large enough to name when it stands alone (`runner_up`: the strongest other hypothesis
     /// once this one is explained away, 1 for none).
     fn detected_alone(&self, score: &FaultScore, runner_up: f64) -> bool {
-        score.significance >= 2.0 * self.min_significance()
+        self.strongly_significant(score)
             && score.score >= self.lone_fault_score
             && score.score >= self.lone_score_ratio * runner_up.max(1.0)
             && score.harmonics_stand(LONE_HARMONIC_RATIO)
@@ -211,7 +216,7 @@ pub fn leader<'a>(scores: &'a [FaultScore], rule: &DecisionRule) -> Option<&'a F
         .filter(|s| matches!(s.fault, FaultKind::OuterRace | FaultKind::Ball))
         .filter(|s| {
             (rule.significant(s) && s.score >= rule.lone_fault_score)
-                || s.significance >= 2.0 * rule.min_significance()
+                || rule.strongly_significant(s)
         })
         .max_by(|a, b| a.score.total_cmp(&b.score));
     Some(cause.unwrap_or(top))

@@ -4,7 +4,7 @@
 
 use bearingd::mcap_log::read_messages;
 use bearingd::messages::PipelineMessage;
-use bearingd_testdata::{check_mcap_with_python, python_mcap, scratch_dir};
+use bearingd_testdata::{check_mcap_with_python, mcap_files, python_mcap, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -13,19 +13,6 @@ fn bearingd(args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("run bearingd")
-}
-
-fn mcap_files(dir: &Path) -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map(|entries| {
-            entries
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
-                .collect()
-        })
-        .unwrap_or_default();
-    files.sort();
-    files
 }
 
 /// (channel, fault, from, to, sample) of every flag change in the logs.

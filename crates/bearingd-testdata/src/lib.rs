@@ -63,6 +63,20 @@ pub fn scratch_dir(test: &str) -> PathBuf {
     dir
 }
 
+/// The `.mcap` files directly in `dir`, sorted by name (empty if it cannot be read).
+pub fn mcap_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|entries| {
+            entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "mcap"))
+                .collect()
+        })
+        .unwrap_or_default();
+    files.sort();
+    files
+}
+
 /// The rows of a data set's `manifest.csv`, each as column name → value.
 ///
 /// # Panics
