@@ -1,10 +1,10 @@
 //! Settings of the analysis core, already validated. The config module builds them from TOML,
 //! `analyze` from its command line; the core never parses text itself.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// How the resonance band for envelope analysis is chosen (MODELS.md §3).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", tag = "method")]
 pub enum BandSelection {
     /// The band of highest spectral kurtosis in the fast kurtogram.
@@ -16,7 +16,7 @@ pub enum BandSelection {
 }
 
 /// Everything the analysis core needs besides the samples, the sample rate and the bearing.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AnalysisSettings {
     /// Length of one envelope-spectrum window, in seconds; rounded up to a power of two samples.
     pub window_s: f64,

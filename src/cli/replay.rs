@@ -1,21 +1,34 @@
 //! `bearingd replay LOG.mcap...`: logged raw samples through the same pipeline, into a new log.
+//!
+//! Says every decision that could make a replay differ from the live run: where the settings
+//! come from (the log, `--config`, or the embedded default for a log without them) and what an
+//! override changes, the order the files are read in, run boundaries, gaps and what could not
+//! be read.
 
-use super::run::print_events;
+use super::run::{event_line, print_events};
 use super::CliError;
 use crate::config::{self, Config};
+use crate::daemon::events::{DaemonEvent, Events};
 use crate::daemon::lock::DirLock;
-use crate::daemon::{replay, ReplayOptions};
-use crate::pipeline::Sink;
+use crate::daemon::{replay, ReplayOptions, ReplaySummary, RunStart};
+use crate::mcap_log::files::utc_text;
+use crate::pipeline::{Sink, SinkError};
 use crate::sinks::mcap::McapSink;
+use crate::sources::replay::plan::{differences, file_list, LoggedSettings, ReplayPlan};
 use clap::Args;
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Duration;
 
 #[derive(Args)]
 pub struct ReplayArgs {
-    /// MCAP logs written by `bearingd run` (or `bearingd import`), replayed in the given order.
+    /// MCAP logs written by `bearingd run` (or `bearingd import`), in any order: they are
+    /// replayed by run, then by their sequence in the run.
     #[arg(required = true)]
     files: Vec<PathBuf>,
-    /// The configuration to analyse with (default: the embedded default's).
+    /// Analyse with this configuration instead of the one the log was recorded with (needed
+    /// for logs without it: older files, `bearingd import`).
     #[arg(long)]
     config: Option<PathBuf>,
     /// Replay speed: 1 = real time; default: as fast as possible.
@@ -24,7 +37,7 @@ pub struct ReplayArgs {
     /// Directory of the replay's own MCAP log.
     #[arg(long, default_value = "bearingd-replay")]
     out: PathBuf,
-    /// No progress lines.
+    /// No progress (neither the bar on a terminal nor the lines elsewhere).
     #[arg(long)]
     quiet: bool,
     /// Print the summary as JSON (flags with their sample times).
@@ -32,11 +45,16 @@ pub struct ReplayArgs {
     json: bool,
 }
 
+/// Where the replay's settings came from.
+#[derive(Clone, Copy, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+enum SettingsFrom {
+    Log,
+    Config,
+    EmbeddedDefault,
+}
+
 pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
-    let mut config = match &args.config {
-        Some(path) => config::load(path).map_err(CliError::input)?,
-        None => Config::default_embedded().map_err(CliError::failure)?,
-    };
     if let Some(speed) = args.speed {
         if !(speed.is_finite() && speed > 0.0) {
             return Err(CliError::input(format!(
@@ -53,51 +71,264 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
         }
         check_mcap_magic(file)?;
     }
+    let plan = ReplayPlan::new(&args.files).map_err(CliError::input)?;
+    if plan.reordered {
+        eprintln!(
+            "bearingd: replay: reading the files by run and sequence, not in the order given: {}",
+            file_list(&plan.files.iter().map(|f| f.path.clone()).collect::<Vec<_>>())
+        );
+    }
+    let (mut config, from, config_differences) = resolve_settings(args, &plan)?;
     config.outputs.mcap_dir = args.out.clone();
     // The output directory has one owner too: recovery at open would otherwise rewrite the
     // open file of a daemon (or another replay) writing there.
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::input(format!("{}: cannot create: {e}", args.out.display())))?;
     let _lock = DirLock::acquire(&args.out).map_err(CliError::input)?;
-    let (sink, _) = McapSink::for_config(&config, 0).map_err(CliError::input)?;
-    let mut sinks: Vec<Box<dyn Sink>> = vec![Box::new(sink)];
+    let mut open_sinks = |run: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {
+        let run_id = run.run_id.unwrap_or(run.origin_ns);
+        let (sink, _) =
+            McapSink::for_run(&config, run.origin_ns, run_id).map_err(|e| SinkError {
+                sink: "MCAP log",
+                count: 1,
+                first: Box::new(e),
+            })?;
+        Ok(vec![Box::new(sink)])
+    };
+    let bar = progress_bar(args, plan.bytes());
     let options = ReplayOptions {
         speed: args.speed,
-        progress: !args.quiet,
+        progress_every: match (&bar, args.quiet) {
+            (Some(_), _) => Some(Duration::from_millis(100)),
+            (None, false) => Some(Duration::from_secs(1)),
+            (None, true) => None,
+        },
     };
-    let summary = replay(&args.files, &config, &options, &mut sinks, &print_events())
-        .map_err(CliError::failure)?;
-    let read = &summary.read;
+    let events = match &bar {
+        Some(bar) => bar_events(bar.clone()),
+        None => print_events(),
+    };
+    let replayed = replay(&plan, &config.clone(), &options, &mut open_sinks, &events);
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let summary = replayed.map_err(CliError::failure)?;
     if args.json {
-        let flags: Vec<_> = summary.flags.iter().collect();
-        let json = serde_json::json!({
-            "raw_blocks": summary.raw_blocks,
-            "samples": summary.samples,
-            "sample_seconds": summary.sample_seconds,
-            "elapsed_s": summary.elapsed.as_secs_f64(),
-            "unreadable_bytes": read.unreadable_bytes(),
-            "unfinished_files": read.unfinished_files(),
-            "unknown_channels": summary.unknown_channels,
-            "flags": flags,
-        });
-        println!("{json}");
+        print_json(&summary, &plan, from, &config_differences);
     } else {
-        for flag in &summary.flags {
-            println!(
-                "flag {}: {} {} -> {} at sample {} (score {:.1})",
-                flag.channel, flag.fault, flag.from, flag.to, flag.end_sample, flag.score
-            );
+        print_text(&summary, &args.out);
+    }
+    report_boundaries_and_losses(&summary, &plan);
+    Ok(())
+}
+
+/// The config to analyse with, where it came from, and how an override differs from the log;
+/// each decision said on stderr.
+fn resolve_settings(
+    args: &ReplayArgs,
+    plan: &ReplayPlan,
+) -> Result<(Config, SettingsFrom, Vec<String>), CliError> {
+    let logged = plan.logged_settings();
+    if let Some(path) = &args.config {
+        let given = config::load(path).map_err(CliError::input)?;
+        eprintln!(
+            "bearingd: replay: analysing with --config {}, not with the settings the log was recorded with",
+            path.display()
+        );
+        let lines = match &logged {
+            LoggedSettings::Logged { config, .. } => differences(config, &given),
+            LoggedSettings::Disagree(groups) => vec![format!(
+                "the files were recorded with {} different settings",
+                groups.len()
+            )],
+            LoggedSettings::Absent | LoggedSettings::Unusable { .. } => Vec::new(),
+        };
+        if lines.is_empty() && matches!(logged, LoggedSettings::Logged { .. }) {
+            eprintln!("bearingd: replay: --config has the log's rates, geometry and settings");
         }
+        for line in &lines {
+            eprintln!("bearingd: replay: --config differs from the log: {line}");
+        }
+        return Ok((given, SettingsFrom::Config, lines));
+    }
+    match logged {
+        LoggedSettings::Logged {
+            config,
+            files_without,
+        } => {
+            let sensors: Vec<String> = config
+                .sensors
+                .iter()
+                .map(|s| format!("{} at {} Hz on {}", s.id, s.sample_rate_hz, s.bearing.name))
+                .collect();
+            eprintln!(
+                "bearingd: replay: settings from the log: {} (give --config to override)",
+                sensors.join("; ")
+            );
+            if !files_without.is_empty() {
+                eprintln!(
+                    "bearingd: replay: {} carry no settings of their own and are analysed with the log's",
+                    file_list(&files_without)
+                );
+            }
+            Ok((*config, SettingsFrom::Log, Vec::new()))
+        }
+        LoggedSettings::Absent => {
+            eprintln!(
+                "bearingd: replay: the log carries no settings (written by an older bearingd or \
+                 by `bearingd import`): analysing with the embedded default's; give --config to choose"
+            );
+            let config = Config::default_embedded().map_err(CliError::failure)?;
+            Ok((config, SettingsFrom::EmbeddedDefault, Vec::new()))
+        }
+        LoggedSettings::Disagree(groups) => Err(CliError::input(format!(
+            "the files were recorded with different settings: {}; replay each group on its \
+             own, or give --config to analyse them all with one",
+            groups
+                .iter()
+                .map(|g| format!("[{}]", file_list(g)))
+                .collect::<Vec<_>>()
+                .join(" vs ")
+        ))),
+        LoggedSettings::Unusable { path, problem } => Err(CliError::input(format!(
+            "{}: {problem}; give --config to replay it with a configuration of your own",
+            path.display()
+        ))),
+    }
+}
+
+/// A progress bar over the bytes of the files, when stderr is a terminal and not `--quiet`.
+fn progress_bar(args: &ReplayArgs, bytes: u64) -> Option<indicatif::ProgressBar> {
+    if args.quiet || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(bytes);
+    let style = indicatif::ProgressStyle::with_template(
+        "replay {bar:30} {bytes}/{total_bytes} ({eta} left) {msg}",
+    )
+    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
+    bar.set_style(style);
+    Some(bar)
+}
+
+/// Events to stderr above the bar; progress moves the bar.
+fn bar_events(bar: indicatif::ProgressBar) -> Events {
+    Arc::new(move |event| match event {
+        DaemonEvent::ReplayProgress {
+            sample_seconds,
+            bytes_read,
+            flag_changes,
+            ..
+        } => {
+            bar.set_position(bytes_read);
+            bar.set_message(format!(
+                "{sample_seconds:.0} s of signal, {flag_changes} flag changes"
+            ));
+        }
+        other => bar.suspend(|| eprintln!("{}", event_line(&other))),
+    })
+}
+
+fn print_json(
+    summary: &ReplaySummary,
+    plan: &ReplayPlan,
+    from: SettingsFrom,
+    config_differences: &[String],
+) {
+    let read = &summary.read;
+    let runs: Vec<_> = summary
+        .runs
+        .iter()
+        .map(|r| {
+            serde_json::json!({
+                "run_id": r.run_id,
+                "origin_ns": r.origin_ns,
+                "origin_utc": utc_text(r.origin_ns),
+                "first_file": r.first_file,
+            })
+        })
+        .collect();
+    let json = serde_json::json!({
+        "raw_blocks": summary.raw_blocks,
+        "samples": summary.samples,
+        "sample_seconds": summary.sample_seconds,
+        "elapsed_s": summary.elapsed.as_secs_f64(),
+        "settings_from": from,
+        "config_differences": config_differences,
+        "order": plan.files.iter().map(|f| &f.path).collect::<Vec<_>>(),
+        "reordered": plan.reordered,
+        "runs": runs,
+        "run_boundaries": summary.runs.len().saturating_sub(1),
+        "gaps": summary.gaps,
+        "gap_count": summary.gap_count,
+        "gap_seconds": summary.gap_seconds,
+        "missing_files": plan.missing,
+        "unreadable_bytes": read.unreadable_bytes(),
+        "unfinished_files": read.unfinished_files(),
+        "undecodable_messages": read.undecodable_messages(),
+        "unknown_channels": summary.unknown_channels,
+        "flags": summary.flags,
+    });
+    println!("{json}");
+}
+
+fn print_text(summary: &ReplaySummary, out: &Path) {
+    for flag in &summary.flags {
         println!(
-            "replayed {} blocks, {} samples ({:.1} s of signal) in {:.2} s ({:.0}× real time); output in {}",
-            summary.raw_blocks,
-            summary.samples,
-            summary.sample_seconds,
-            summary.elapsed.as_secs_f64(),
-            summary.sample_seconds / summary.elapsed.as_secs_f64().max(1e-9),
-            args.out.display()
+            "flag {}: {} {} -> {} at sample {} (score {:.1})",
+            flag.channel, flag.fault, flag.from, flag.to, flag.end_sample, flag.score
         );
     }
+    println!(
+        "replayed {} blocks, {} samples ({:.1} s of signal) in {} run(s) in {:.2} s ({:.0}× real time); output in {}",
+        summary.raw_blocks,
+        summary.samples,
+        summary.sample_seconds,
+        summary.runs.len(),
+        summary.elapsed.as_secs_f64(),
+        summary.sample_seconds / summary.elapsed.as_secs_f64().max(1e-9),
+        out.display()
+    );
+}
+
+/// Run boundaries, gaps, missing files and what could not be read, on stderr.
+fn report_boundaries_and_losses(summary: &ReplaySummary, plan: &ReplayPlan) {
+    for pair in summary.runs.windows(2) {
+        let (before, after) = (&pair[0], &pair[1]);
+        eprintln!(
+            "bearingd: replay: run boundary at {}: run {} (sample 0 at {}) follows run {}: the \
+             daemon restarted (a crash or a stop); the pipeline starts again",
+            after.first_file.display(),
+            after.run_id.map_or("without metadata".into(), |r| r.to_string()),
+            utc_text(after.origin_ns),
+            before
+                .run_id
+                .map_or("without metadata".into(), |r| r.to_string()),
+        );
+    }
+    const GAP_LINES: usize = 10;
+    for gap in summary.gaps.iter().take(GAP_LINES) {
+        eprintln!(
+            "bearingd: replay: gap in {}: {:.3} s ({} samples) missing from sample {}",
+            gap.channel, gap.seconds, gap.missing_samples, gap.at_sample
+        );
+    }
+    if summary.gap_count > GAP_LINES as u64 {
+        eprintln!(
+            "bearingd: replay: {} gaps in all, {:.3} s of signal missing (--json lists them)",
+            summary.gap_count, summary.gap_seconds
+        );
+    }
+    for missing in &plan.missing {
+        eprintln!(
+            "bearingd: replay: run {}: file {} of the run is not among those given (after {}; \
+             deleted by retention, or not given)",
+            missing.run_id,
+            missing.sequence,
+            missing.after.display()
+        );
+    }
+    let read = &summary.read;
     if read.unreadable_bytes() > 0 || read.unfinished_files() > 0 {
         eprintln!(
             "bearingd: replay: {} unfinished file(s); {} bytes could not be read (read up to the last complete chunk)",
@@ -111,7 +342,6 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
             summary.unknown_channels.join(", ")
         );
     }
-    Ok(())
 }
 
 /// Refuses a file that does not start with the MCAP magic: replaying it would read nothing and

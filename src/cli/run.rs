@@ -185,7 +185,7 @@ pub(super) fn print_events() -> Events {
 }
 
 /// How an event other than a status reads on stderr.
-fn event_line(event: &DaemonEvent) -> String {
+pub(super) fn event_line(event: &DaemonEvent) -> String {
     match event {
         DaemonEvent::Recovered(report) => recovery_line(report),
         DaemonEvent::StaleLockTakenOver { path, previous } => format!(
@@ -254,16 +254,15 @@ fn event_line(event: &DaemonEvent) -> String {
         DaemonEvent::ReplayUnreadable(error) => format!("bearingd: replay: {error}"),
         DaemonEvent::ReplayProgress {
             sample_seconds,
-            elapsed_s,
+            bytes_read,
+            bytes_total,
             raw_blocks,
             flag_changes,
         } => format!(
-            "replay: {:.0} s of signal in {:.1} s ({:.0}× real time), {} blocks, {} flag changes",
-            sample_seconds,
-            elapsed_s,
-            sample_seconds / elapsed_s.max(1e-9),
-            raw_blocks,
-            flag_changes
+            "replay: {:.0} % of {} bytes, {sample_seconds:.0} s of signal, {raw_blocks} blocks, \
+             {flag_changes} flag changes",
+            100.0 * *bytes_read as f64 / (*bytes_total).max(1) as f64,
+            bytes_total,
         ),
     }
 }

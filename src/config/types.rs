@@ -3,14 +3,14 @@
 
 use std::path::PathBuf;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::analysis::AnalysisSettings;
 use crate::bearing::BearingGeometry;
 use crate::messages::SpeedSource;
 
 /// A complete, validated configuration.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Config {
     /// At least one sensor; ids, CAN nodes and iceoryx2 services are unique.
     pub sensors: Vec<SensorConfig>,
@@ -45,7 +45,7 @@ impl Config {
 }
 
 /// One accelerometer (`[[sensors]]`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SensorConfig {
     /// Unique, `[a-z0-9_-]{1,32}`; names MCAP channels and iceoryx2 services.
     pub id: String,
@@ -71,7 +71,7 @@ impl SensorConfig {
 }
 
 /// Where a sensor's samples come from.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Transport {
     /// The in-process simulated sensor node.
@@ -83,7 +83,7 @@ pub enum Transport {
 }
 
 /// `[sensors.can]`.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct CanConfig {
     /// SocketCAN interface, e.g. `can0`; at most 15 bytes (the kernel's limit).
     pub interface: String,
@@ -94,14 +94,14 @@ pub struct CanConfig {
 }
 
 /// `[sensors.shm]`.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct ShmConfig {
     /// iceoryx2 service carrying the samples; starts with `bearingd/`.
     pub service: String,
 }
 
 /// `[sensors.sim]`.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SimConfig {
     /// The fault the simulated bearing develops.
     pub fault: SimFault,
@@ -128,7 +128,7 @@ impl Default for SimConfig {
 }
 
 /// Which fault the simulator produces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SimFault {
     None,
@@ -138,7 +138,7 @@ pub enum SimFault {
 }
 
 /// How a sensor's shaft speed is known (`[sensors.speed]`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "source", rename_all = "snake_case")]
 pub enum Speed {
     /// A constant speed, in revolutions per minute; in (0, 100 000).
@@ -200,7 +200,7 @@ pub(crate) const DEFAULT_MAX_RPM_FACTOR: f64 = 1.5;
 pub(crate) const DEFAULT_SPEED_SEARCH: f64 = 0.05;
 
 /// `[twin]`: the signal-model twin's re-fit schedule.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TwinConfig {
     /// Sample time between re-fits, in seconds.
     pub refit_period_s: f64,
@@ -218,7 +218,7 @@ impl Default for TwinConfig {
 }
 
 /// `[thresholds]`: fault flags (ok, watch, alarm) with hysteresis, and the health baseline.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ThresholdConfig {
     /// Fault score at which a flag rises to watch.
     pub watch_score: f64,
@@ -252,7 +252,7 @@ impl Default for ThresholdConfig {
 }
 
 /// `[outputs]`: files, services and status.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct OutputConfig {
     /// Persistent state (baselines, band choices).
     pub state_dir: PathBuf,
@@ -312,7 +312,7 @@ pub(crate) const DEFAULT_AXIS: &str = "radial";
 pub(crate) const DEFAULT_CAN_INTERFACE: &str = "can0";
 
 /// Where the broker is, and whether to speak TLS to it.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Broker {
     /// `mqtts://`: TLS (rustls).
     pub tls: bool,
@@ -328,7 +328,7 @@ impl std::fmt::Display for Broker {
 }
 
 /// The validated `[fleet]` section (present only when `enabled = true`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FleetConfig {
     pub broker: Broker,
     /// Sparkplug group id: 1 to 64 of `A-Z a-z 0-9 - _ .`.

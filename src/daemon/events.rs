@@ -75,10 +75,11 @@ pub enum DaemonEvent {
     Status(Vec<ChannelStatus>),
     /// A message of a replayed log could not be read; the replay goes on.
     ReplayUnreadable(McapLogError),
-    /// About once a second of a replay.
+    /// A replay's progress, every [`crate::daemon::ReplayOptions::progress_every`].
     ReplayProgress {
         sample_seconds: f64,
-        elapsed_s: f64,
+        bytes_read: u64,
+        bytes_total: u64,
         raw_blocks: u64,
         flag_changes: usize,
     },

@@ -1,6 +1,18 @@
 //! `bearingd replay`: the replay source ([`ReplaySource`]) through the same [`Pipeline`] as
-//! the live run, into the same sinks, on one thread. Truncated files are read up to their last
-//! complete chunk, and the summary says how much could not be read.
+//! the live run, into the same sinks, on one thread, run by run ([`ReplayPlan`]).
+//!
+//! - A run boundary (another run id: the daemon stopped or crashed and started again) starts
+//!   a new pipeline and new sinks, as the restarted daemon did: its sample time starts again
+//!   at 0, and its output log is dated with its own wall-clock origin. The new pipeline keeps
+//!   the health baselines the previous run reached, standing in for the `baselines.json` the
+//!   restarted daemon loaded (the log does not record that file; it was saved at most
+//!   `state_save_interval_s` before the crash).
+//! - A gap inside a run (a channel's next raw block starts after where the last one ended:
+//!   frames lost live, a damaged chunk, a missing file) is reported with its length and does
+//!   not reset anything: the channel's windows restart after it, exactly as the live pipeline
+//!   did for a gap it saw, so flags before and after stay those of the live run.
+//! - Truncated files are read up to their last complete chunk, and the summary says how much
+//!   could not be read.
 //!
 //! The twin's re-fits run inline here (the live run does them on their own thread): they do
 //! not influence flags, so the flags of a replay equal the live run's at the same samples.
@@ -8,10 +20,11 @@
 use super::events::{DaemonEvent, Events};
 use crate::config::Config;
 use crate::mcap_log::ReadSummary;
-use crate::messages::{FlagMessage, PipelineMessage};
-use crate::pipeline::{Output, Pipeline, Sink, SinkError, TwinWorker};
+use crate::messages::{ChannelId, FlagMessage, PipelineMessage};
+use crate::pipeline::{Input, Output, Pipeline, Sink, SinkError, TwinWorker};
+use crate::sources::replay::plan::{PlannedRun, ReplayPlan};
 use crate::sources::replay::ReplaySource;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -20,9 +33,35 @@ use std::time::{Duration, Instant};
 pub struct ReplayOptions {
     /// `None`: as fast as possible; `Some(1.0)`: real time; `Some(10.0)`: ten times faster.
     pub speed: Option<f64>,
-    /// Report progress ([`DaemonEvent::ReplayProgress`]) about once a second.
-    pub progress: bool,
+    /// Report progress ([`DaemonEvent::ReplayProgress`]) this often; `None`: never.
+    pub progress_every: Option<Duration>,
 }
+
+/// Where a run of the replay starts, for whoever opens its sinks.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+pub struct RunStart {
+    /// The original run's id; `None` for files without metadata.
+    pub run_id: Option<u64>,
+    /// Wall-clock time of the run's sample 0: from its metadata, else from its first raw
+    /// block's log time, else 0.
+    pub origin_ns: u64,
+    /// The run's first file.
+    pub first_file: PathBuf,
+}
+
+/// Samples missing inside a run between two raw blocks of one channel.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Gap {
+    pub run_id: Option<u64>,
+    pub channel: String,
+    /// The first missing sample.
+    pub at_sample: u64,
+    pub missing_samples: u64,
+    pub seconds: f64,
+}
+
+/// At most this many gaps are kept one by one (all are counted).
+const GAPS_KEPT: usize = 1000;
 
 #[derive(Debug)]
 pub struct ReplaySummary {
@@ -32,7 +71,14 @@ pub struct ReplaySummary {
     pub read: ReadSummary,
     pub unknown_channels: Vec<String>,
     pub elapsed: Duration,
+    /// Seconds of signal replayed, summed over runs.
     pub sample_seconds: f64,
+    /// Every run replayed, in order; from the second on, each is a boundary.
+    pub runs: Vec<RunStart>,
+    /// The first [`GAPS_KEPT`] gaps inside runs.
+    pub gaps: Vec<Gap>,
+    pub gap_count: u64,
+    pub gap_seconds: f64,
 }
 
 /// Why a replay failed.
@@ -42,88 +88,227 @@ pub enum ReplayError {
     Sink(#[from] SinkError),
 }
 
-/// Replays `paths` (in order) with `config`'s sensors, into `sinks`.
+/// Replays the runs of `plan` with `config`'s sensors; `open_sinks` gives the sinks of each
+/// run (called at its first output, when its time origin is known).
 pub fn replay(
-    paths: &[PathBuf],
+    plan: &ReplayPlan,
     config: &Config,
     options: &ReplayOptions,
-    sinks: &mut [Box<dyn Sink>],
+    open_sinks: &mut dyn FnMut(&RunStart) -> Result<Vec<Box<dyn Sink>>, SinkError>,
     events: &Events,
 ) -> Result<ReplaySummary, ReplayError> {
-    let mut pipeline = Pipeline::new(config, &BTreeMap::new());
-    let mut source = ReplaySource::open(
-        paths,
-        pipeline.channels().cloned().collect::<Vec<_>>(),
-        config.sample_rates(),
-        options.speed,
-    );
-    let mut worker = TwinWorker::default();
-    let mut flags = Vec::new();
     let started = Instant::now();
-    let mut last_progress = started;
-    let mut outputs = Vec::new();
-    while let Some(item) = source.next() {
-        let input = match item {
-            Ok(input) => input,
-            Err(e) => {
-                events(DaemonEvent::ReplayUnreadable(e));
-                continue;
+    let mut summary = ReplaySummary {
+        raw_blocks: 0,
+        samples: 0,
+        flags: Vec::new(),
+        read: ReadSummary::default(),
+        unknown_channels: Vec::new(),
+        elapsed: Duration::ZERO,
+        sample_seconds: 0.0,
+        runs: Vec::new(),
+        gaps: Vec::new(),
+        gap_count: 0,
+        gap_seconds: 0.0,
+    };
+    let mut progress = Progress {
+        every: options.progress_every,
+        last: started,
+        bytes_before: 0,
+        bytes_total: plan.bytes(),
+    };
+    let mut baselines = BTreeMap::new();
+    for run in &plan.runs {
+        let mut replayed = RunReplay::new(run, plan, config, &baselines, options);
+        let result = replayed.go(open_sinks, &mut summary, &mut progress, events);
+        baselines = replayed.pipeline.baselines();
+        let counters = replayed.source.counters().clone();
+        progress.bytes_before += counters.bytes_read;
+        summary.raw_blocks += counters.raw_blocks;
+        summary.samples += counters.samples;
+        summary.sample_seconds += counters.sample_seconds;
+        for name in counters.unknown_channels {
+            if !summary.unknown_channels.contains(&name) {
+                summary.unknown_channels.push(name);
             }
-        };
-        pipeline.handle(input, &mut |output| outputs.push(output));
-        for output in outputs.drain(..) {
-            deliver(output, sinks, &mut flags, &mut worker);
         }
-        if options.progress && last_progress.elapsed() >= Duration::from_secs(1) {
-            last_progress = Instant::now();
-            let read = source.counters();
-            events(DaemonEvent::ReplayProgress {
-                sample_seconds: read.sample_seconds,
-                elapsed_s: started.elapsed().as_secs_f64(),
-                raw_blocks: read.raw_blocks,
-                flag_changes: flags.len(),
-            });
-        }
+        summary
+            .read
+            .files
+            .extend(replayed.source.read_summary().files.iter().cloned());
+        result?;
     }
-    let mut first_error = None;
-    for sink in sinks.iter_mut() {
-        if let Err(e) = sink.finish() {
-            first_error.get_or_insert(e);
-        }
-    }
-    if let Some(e) = first_error {
-        return Err(e.into());
-    }
-    let read = source.counters().clone();
-    Ok(ReplaySummary {
-        raw_blocks: read.raw_blocks,
-        samples: read.samples,
-        flags,
-        read: source.read_summary().clone(),
-        unknown_channels: read.unknown_channels,
-        elapsed: started.elapsed(),
-        sample_seconds: read.sample_seconds,
-    })
+    summary.elapsed = started.elapsed();
+    Ok(summary)
 }
 
-/// One output of the pipeline: a message to every sink, a twin request fitted now.
-fn deliver(
-    output: Output,
-    sinks: &mut [Box<dyn Sink>],
-    flags: &mut Vec<FlagMessage>,
-    worker: &mut TwinWorker,
-) {
-    let message = match output {
-        Output::Message(message) => message,
-        Output::Twin(request) => match worker.refit(&request) {
-            Some(twin) => PipelineMessage::Twin(twin),
-            None => return,
-        },
-    };
-    if let PipelineMessage::Flag(flag) = &message {
-        flags.push(flag.clone());
+/// When to report progress, and how far the files before this run went.
+struct Progress {
+    every: Option<Duration>,
+    last: Instant,
+    bytes_before: u64,
+    bytes_total: u64,
+}
+
+/// One run: its source, a pipeline of its own, and its sinks once opened.
+struct RunReplay<'a> {
+    run: &'a PlannedRun,
+    source: ReplaySource,
+    pipeline: Pipeline,
+    sinks: Option<Vec<Box<dyn Sink>>>,
+    worker: TwinWorker,
+    /// Per channel: the sample after its last raw block, and its sample rate.
+    next_sample: HashMap<ChannelId, u64>,
+    rates: HashMap<String, f64>,
+    first_file: PathBuf,
+}
+
+impl<'a> RunReplay<'a> {
+    fn new(
+        run: &'a PlannedRun,
+        plan: &ReplayPlan,
+        config: &Config,
+        baselines: &BTreeMap<ChannelId, crate::analysis::health::Baseline>,
+        options: &ReplayOptions,
+    ) -> Self {
+        let pipeline = Pipeline::new(config, baselines);
+        let paths = plan.paths(run);
+        let source = ReplaySource::open(
+            &paths,
+            pipeline.channels().cloned().collect::<Vec<_>>(),
+            config.sample_rates(),
+            options.speed,
+        );
+        RunReplay {
+            run,
+            source,
+            pipeline,
+            sinks: None,
+            worker: TwinWorker::default(),
+            next_sample: HashMap::new(),
+            rates: config.sample_rates(),
+            first_file: paths.first().cloned().unwrap_or_default(),
+        }
     }
-    for sink in sinks.iter_mut() {
-        sink.write(&message);
+
+    fn go(
+        &mut self,
+        open_sinks: &mut dyn FnMut(&RunStart) -> Result<Vec<Box<dyn Sink>>, SinkError>,
+        summary: &mut ReplaySummary,
+        progress: &mut Progress,
+        events: &Events,
+    ) -> Result<(), ReplayError> {
+        let mut outputs = Vec::new();
+        while let Some(item) = self.source.next() {
+            let input = match item {
+                Ok(input) => input,
+                Err(e) => {
+                    events(DaemonEvent::ReplayUnreadable(e));
+                    continue;
+                }
+            };
+            self.note_gap(&input, summary);
+            self.pipeline
+                .handle(input, &mut |output| outputs.push(output));
+            if !outputs.is_empty() && self.sinks.is_none() {
+                self.open(open_sinks, summary)?;
+            }
+            for output in outputs.drain(..) {
+                self.deliver(output, &mut summary.flags);
+            }
+            if progress.every.is_some_and(|e| progress.last.elapsed() >= e) {
+                progress.last = Instant::now();
+                let read = self.source.counters();
+                events(DaemonEvent::ReplayProgress {
+                    sample_seconds: summary.sample_seconds + read.sample_seconds,
+                    bytes_read: progress.bytes_before + read.bytes_read,
+                    bytes_total: progress.bytes_total,
+                    raw_blocks: summary.raw_blocks + read.raw_blocks,
+                    flag_changes: summary.flags.len(),
+                });
+            }
+        }
+        let Some(sinks) = self.sinks.as_mut() else {
+            return Ok(());
+        };
+        let mut first_error = None;
+        for sink in sinks.iter_mut() {
+            if let Err(e) = sink.finish() {
+                first_error.get_or_insert(e);
+            }
+        }
+        match first_error {
+            Some(e) => Err(e.into()),
+            None => Ok(()),
+        }
+    }
+
+    fn open(
+        &mut self,
+        open_sinks: &mut dyn FnMut(&RunStart) -> Result<Vec<Box<dyn Sink>>, SinkError>,
+        summary: &mut ReplaySummary,
+    ) -> Result<(), ReplayError> {
+        let start = RunStart {
+            run_id: self.run.run_id,
+            origin_ns: self
+                .run
+                .origin_ns
+                .or(self.source.counters().first_block_origin_ns)
+                .unwrap_or(0),
+            first_file: self.first_file.clone(),
+        };
+        self.sinks = Some(open_sinks(&start)?);
+        summary.runs.push(start);
+        Ok(())
+    }
+
+    /// Records a gap when a channel's block starts past where its last one ended.
+    fn note_gap(&mut self, input: &Input, summary: &mut ReplaySummary) {
+        let Input::Samples {
+            channel,
+            first_sample,
+            counts,
+            ..
+        } = input
+        else {
+            return;
+        };
+        let end = first_sample + counts.len() as u64;
+        let Some(expected) = self.next_sample.insert(channel.clone(), end) else {
+            return;
+        };
+        if *first_sample > expected {
+            let missing = first_sample - expected;
+            let fs = self.rates.get(&channel.sensor).copied().unwrap_or(1.0);
+            let seconds = missing as f64 / fs;
+            summary.gap_count += 1;
+            summary.gap_seconds += seconds;
+            if summary.gaps.len() < GAPS_KEPT {
+                summary.gaps.push(Gap {
+                    run_id: self.run.run_id,
+                    channel: channel.to_string(),
+                    at_sample: expected,
+                    missing_samples: missing,
+                    seconds,
+                });
+            }
+        }
+    }
+
+    /// One output of the pipeline: a message to every sink, a twin request fitted now.
+    fn deliver(&mut self, output: Output, flags: &mut Vec<FlagMessage>) {
+        let message = match output {
+            Output::Message(message) => message,
+            Output::Twin(request) => match self.worker.refit(&request) {
+                Some(twin) => PipelineMessage::Twin(twin),
+                None => return,
+            },
+        };
+        if let PipelineMessage::Flag(flag) = &message {
+            flags.push(flag.clone());
+        }
+        for sink in self.sinks.iter_mut().flatten() {
+            sink.write(&message);
+        }
     }
 }

@@ -19,6 +19,7 @@
 
 pub(crate) mod error;
 pub mod files;
+pub mod header;
 pub mod reader;
 pub mod scan;
 pub mod schema;
@@ -26,6 +27,7 @@ pub mod verify;
 
 pub use error::{McapLogError, Result};
 pub use files::{file_name, is_log_file_name};
+pub use header::{read_header, LogHeader};
 pub use reader::{
     read_messages, read_raw_blocks, FileReadReport, LogReader, LoggedMessage, RawBlocks,
     ReadSummary,

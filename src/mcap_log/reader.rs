@@ -79,6 +79,8 @@ pub struct LogReader {
     report: FileReadReport,
     summary: ReadSummary,
     raw_only: bool,
+    /// Bytes of the files finished so far.
+    bytes_done: u64,
 }
 
 /// Reads every pipeline message of `paths`.
@@ -131,6 +133,7 @@ impl LogReader {
             report: FileReadReport::default(),
             summary: ReadSummary::default(),
             raw_only,
+            bytes_done: 0,
         }
     }
 
@@ -139,8 +142,14 @@ impl LogReader {
         &self.summary
     }
 
+    /// Bytes read so far, over every file (for progress).
+    pub fn bytes_read(&self) -> u64 {
+        self.bytes_done + self.current.as_ref().map_or(0, Scanner::offset)
+    }
+
     fn close_current(&mut self) {
         if let Some(scanner) = self.current.take() {
+            self.bytes_done += scanner.file_len();
             self.report.scan = scanner.outcome().clone();
             self.summary.files.push(std::mem::take(&mut self.report));
         }

@@ -121,6 +121,16 @@ impl Scanner {
         &self.path
     }
 
+    /// The file's size when it was opened.
+    pub fn file_len(&self) -> u64 {
+        self.file_len
+    }
+
+    /// Bytes read so far (the end of the last top-level record).
+    pub fn offset(&self) -> u64 {
+        self.offset
+    }
+
     /// The outcome so far (final once [`Scanner::next_record`] returned `Ok(None)`).
     pub fn outcome(&self) -> &ScanOutcome {
         &self.outcome

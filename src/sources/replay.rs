@@ -6,6 +6,10 @@
 //! at the same samples as the live run did. Truncated files are read up to their last complete
 //! chunk ([`crate::mcap_log::reader`]); what could not be read is counted there and each
 //! unreadable message is handed on as an error, never a panic.
+//!
+//! Which files, in which order, as which runs, with which settings: [`plan`].
+
+pub mod plan;
 
 use crate::mcap_log::{read_messages, LogReader, McapLogError, ReadSummary};
 use crate::messages::{ChannelId, PipelineMessage};
@@ -24,6 +28,11 @@ pub struct ReplayCounters {
     pub sample_seconds: f64,
     /// Channels in the logs that the config does not know (skipped), in order of appearance.
     pub unknown_channels: Vec<String>,
+    /// Bytes of the files read so far.
+    pub bytes_read: u64,
+    /// The log time of sample 0, as the first raw block's log time tells it
+    /// (`log_time - first_sample / rate`): the time base of a log without metadata.
+    pub first_block_origin_ns: Option<u64>,
 }
 
 /// Logged inputs of `paths` for the channels the pipeline knows.
@@ -83,10 +92,13 @@ impl Iterator for ReplaySource {
 
     fn next(&mut self) -> Option<Self::Item> {
         loop {
-            let logged = match self.reader.next()? {
+            let next = self.reader.next();
+            self.counters.bytes_read = self.reader.bytes_read();
+            let logged = match next? {
                 Ok(logged) => logged,
                 Err(e) => return Some(Err(e)),
             };
+            let log_time = logged.log_time;
             let block = match logged.message {
                 PipelineMessage::Raw(block) => block,
                 // Measured speeds are inputs like the raw samples; the pipeline uses them if the
@@ -107,6 +119,12 @@ impl Iterator for ReplaySource {
                 .get(&block.channel.sensor)
                 .copied()
                 .unwrap_or(block.sample_rate_hz);
+            if self.counters.first_block_origin_ns.is_none() {
+                // The log's time base used the rate it was recorded at.
+                let logged_fs = Some(block.sample_rate_hz).filter(|r| *r > 0.0).unwrap_or(fs);
+                let since_origin = (block.first_sample as f64 / logged_fs * 1e9) as u64;
+                self.counters.first_block_origin_ns = Some(log_time.saturating_sub(since_origin));
+            }
             self.counters.raw_blocks += 1;
             self.counters.samples += block.counts.len() as u64;
             self.counters.sample_seconds = self.counters.sample_seconds.max(end as f64 / fs);

@@ -15,6 +15,7 @@
 
 use crate::config::Config;
 use crate::mcap_log::files::utc_text;
+use crate::mcap_log::header::{CHANNEL_RECORD, CONFIG_RECORD, FILE_RECORD, RUN_RECORD};
 use std::collections::BTreeMap;
 
 /// One metadata record: name and key/value pairs.
@@ -32,7 +33,7 @@ fn record(name: &str, pairs: impl IntoIterator<Item = (&'static str, String)>) -
 pub fn run_records(config: &Config, origin_ns: u64, run_id: u64) -> Vec<MetadataRecord> {
     let mut records = vec![
         record(
-            "bearingd.run",
+            RUN_RECORD,
             [
                 ("version", env!("CARGO_PKG_VERSION").to_string()),
                 ("host", host_name()),
@@ -48,7 +49,7 @@ pub fn run_records(config: &Config, origin_ns: u64, run_id: u64) -> Vec<Metadata
             ],
         ),
         record(
-            "bearingd.config",
+            CONFIG_RECORD,
             [(
                 "json",
                 serde_json::to_string(config).unwrap_or_else(|e| format!("unserialisable: {e}")),
@@ -59,7 +60,7 @@ pub fn run_records(config: &Config, origin_ns: u64, run_id: u64) -> Vec<Metadata
         for axis in &sensor.axes {
             let channel = format!("{}/{axis}", sensor.id);
             records.push(record(
-                "bearingd.channel",
+                CHANNEL_RECORD,
                 [
                     ("topic", format!("/raw/{channel}")),
                     ("channel", channel),
@@ -81,7 +82,7 @@ pub fn run_records(config: &Config, origin_ns: u64, run_id: u64) -> Vec<Metadata
 /// The `bearingd.file` record of the `sequence`-th file of a run, opened at `opened_at_ns`.
 pub fn file_record(sequence: u64, opened_at_ns: u64) -> MetadataRecord {
     record(
-        "bearingd.file",
+        FILE_RECORD,
         [
             ("sequence", sequence.to_string()),
             ("opened_at_utc", utc_text(opened_at_ns)),

@@ -75,8 +75,18 @@ impl McapSink {
         config: &Config,
         origin_ns: u64,
     ) -> Result<(Self, Vec<RecoveryReport>), McapLogError> {
+        McapSink::for_run(config, origin_ns, origin_ns)
+    }
+
+    /// [`for_config`](Self::for_config) for a run named `run_id` (a replay keeps the
+    /// original run's id and origin, so that its log is dated as the original was).
+    pub fn for_run(
+        config: &Config,
+        origin_ns: u64,
+        run_id: u64,
+    ) -> Result<(Self, Vec<RecoveryReport>), McapLogError> {
         let logger = LoggerConfig {
-            metadata: metadata::run_records(config, origin_ns, origin_ns),
+            metadata: metadata::run_records(config, origin_ns, run_id),
             ..logger_config(config)
         };
         McapSink::open(logger, config.sample_rates(), origin_ns)
