@@ -75,7 +75,13 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     if plan.reordered {
         eprintln!(
             "bearingd: replay: reading the files by run and sequence, not in the order given: {}",
-            file_list(&plan.files.iter().map(|f| f.path.clone()).collect::<Vec<_>>())
+            file_list(
+                &plan
+                    .files
+                    .iter()
+                    .map(|f| f.path.clone())
+                    .collect::<Vec<_>>()
+            )
         );
     }
     let (mut config, from, config_differences) = resolve_settings(args, &plan)?;
@@ -299,7 +305,9 @@ fn report_boundaries_and_losses(summary: &ReplaySummary, plan: &ReplayPlan) {
             "bearingd: replay: run boundary at {}: run {} (sample 0 at {}) follows run {}: the \
              daemon restarted (a crash or a stop); the pipeline starts again",
             after.first_file.display(),
-            after.run_id.map_or("without metadata".into(), |r| r.to_string()),
+            after
+                .run_id
+                .map_or("without metadata".into(), |r| r.to_string()),
             utc_text(after.origin_ns),
             before
                 .run_id

@@ -121,7 +121,9 @@ impl Iterator for ReplaySource {
                 .unwrap_or(block.sample_rate_hz);
             if self.counters.first_block_origin_ns.is_none() {
                 // The log's time base used the rate it was recorded at.
-                let logged_fs = Some(block.sample_rate_hz).filter(|r| *r > 0.0).unwrap_or(fs);
+                let logged_fs = Some(block.sample_rate_hz)
+                    .filter(|r| *r > 0.0)
+                    .unwrap_or(fs);
                 let since_origin = (block.first_sample as f64 / logged_fs * 1e9) as u64;
                 self.counters.first_block_origin_ns = Some(log_time.saturating_sub(since_origin));
             }

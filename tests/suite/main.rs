@@ -12,6 +12,7 @@ mod formats;
 mod kinematics;
 mod monitor;
 mod physics;
+mod replay;
 mod severity;
 mod speed;
 mod twin;

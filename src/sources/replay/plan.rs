@@ -58,17 +58,18 @@ impl ReplayPlan {
         let mut files = given.clone();
         // Stable: files without a run id keep the order given.
         files.sort_by_key(|h| h.run_id.map(|run| (run, h.sequence.unwrap_or(0))));
-        let reordered = files.iter().map(|h| &h.path).ne(given.iter().map(|h| &h.path));
+        let reordered = files
+            .iter()
+            .map(|h| &h.path)
+            .ne(given.iter().map(|h| &h.path));
         let mut runs: Vec<PlannedRun> = Vec::new();
         let mut missing = Vec::new();
         for (i, file) in files.iter().enumerate() {
             match runs.last_mut() {
                 Some(run) if run.run_id == file.run_id => {
-                    if let (Some(run_id), Some(seq), Some(before)) = (
-                        file.run_id,
-                        file.sequence,
-                        files[i - 1].sequence,
-                    ) {
+                    if let (Some(run_id), Some(seq), Some(before)) =
+                        (file.run_id, file.sequence, files[i - 1].sequence)
+                    {
                         missing.extend((before + 1..seq).map(|sequence| MissingFile {
                             run_id,
                             sequence,
@@ -221,7 +222,10 @@ pub fn config_from_log(json: &str) -> Result<Config, String> {
         (1..=1024).contains(&a.averages) && (1..=100).contains(&a.harmonics),
         "analysis.averages or harmonics".into(),
     );
-    check(positive(config.band_period_s), "analysis.band_period_s".into());
+    check(
+        positive(config.band_period_s),
+        "analysis.band_period_s".into(),
+    );
     check(
         positive(config.twin.refit_period_s) && positive(config.twin.window_s),
         "twin".into(),
@@ -297,7 +301,12 @@ fn geometry(b: &crate::bearing::BearingGeometry) -> String {
 pub fn file_list(paths: &[PathBuf]) -> String {
     paths
         .iter()
-        .map(|p| p.file_name().map_or(p.as_path(), Path::new).display().to_string())
+        .map(|p| {
+            p.file_name()
+                .map_or(p.as_path(), Path::new)
+                .display()
+                .to_string()
+        })
         .collect::<Vec<_>>()
         .join(", ")
 }

@@ -1,0 +1,356 @@
+//! Faithful replay (issue 11 item 3): `bearingd replay` takes the sample rate, geometry and
+//! settings from the log's metadata, reads files by run and sequence whatever order they are
+//! given in, restarts the pipeline at a run boundary (a crash and restart) and says so, reports
+//! a gap inside a run with its length, dates its own log with the original run's UTC time base
+//! (read back by Python's strict `mcap` reader), and writes the same bytes when run twice.
+
+use bearingd::mcap_log::read_messages;
+use bearingd::messages::PipelineMessage;
+use bearingd_testdata::{mcap_files, python_mcap, scratch_dir};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn bearingd(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(args)
+        .output()
+        .expect("run bearingd")
+}
+
+fn stderr_of(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// The embedded default at `rate_hz`, files rotated every `file_s` of log time, an iceoryx2
+/// root of its own; written to `dir/<name>.toml`.
+fn config_at(dir: &Path, name: &str, rate_hz: u32, file_s: u32) -> PathBuf {
+    let out = bearingd(&["config", "default"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout)
+        .unwrap()
+        .replace(
+            "sample_rate_hz = 25600",
+            &format!("sample_rate_hz = {rate_hz}"),
+        )
+        .replace(
+            "mcap_max_file_s = 3600",
+            &format!("mcap_max_file_s = {file_s}"),
+        )
+        .replace(
+            "\"/run/bearingd/iceoryx2\"",
+            &format!("\"/dev/shm/bearingd-replay-{name}-{}\"", std::process::id()),
+        );
+    assert!(text.contains(&format!("sample_rate_hz = {rate_hz}")));
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `bearingd run --fast` of `config` on `data` for `seconds` of signal.
+fn fast_run(config: &Path, data: &Path, seconds: &str) {
+    let out = bearingd(&[
+        "run",
+        "--config",
+        config.to_str().unwrap(),
+        "--data-dir",
+        data.to_str().unwrap(),
+        "--fast",
+        "--quiet",
+        "--duration",
+        seconds,
+    ]);
+    assert!(out.status.success(), "{}", stderr_of(&out));
+}
+
+/// (channel, fault, from, to, sample) of every flag change in the logs.
+fn logged_flags(files: &[PathBuf]) -> Vec<(String, String, String, u64)> {
+    read_messages(files)
+        .filter_map(|m| match m.expect("readable log").message {
+            PipelineMessage::Flag(f) => Some((
+                f.channel.to_string(),
+                f.fault.to_string(),
+                f.to.to_string(),
+                f.end_sample,
+            )),
+            _ => None,
+        })
+        .collect()
+}
+
+/// What `tests/python/log_metadata.py` (Python `mcap`, strict) reads from `file`.
+fn python_metadata(py: &Path, file: &Path) -> serde_json::Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/log_metadata.py");
+    let out = Command::new(py).arg(script).arg(file).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}: {}",
+        file.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn replay_json(files: &[PathBuf], out: &Path, extra: &[&str]) -> (serde_json::Value, String) {
+    let mut args = vec![
+        "replay",
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    args.extend(files.iter().map(|f| f.to_str().unwrap()));
+    let result = bearingd(&args);
+    let stderr = stderr_of(&result);
+    assert!(result.status.success(), "{stderr}");
+    (serde_json::from_slice(&result.stdout).unwrap(), stderr)
+}
+
+/// Regression test of issue 11 item 3: a run at 12.8 kHz (not the default 25.6 kHz) rotated
+/// every 20 s, then a restart killed with `kill -9`; the files replayed newest first, without
+/// `--config`.
+#[test]
+fn issue_11_replay_takes_rate_order_and_run_boundaries_from_the_log() {
+    let dir = scratch_dir("replay-faithful");
+    let data = dir.join("data");
+    let config = config_at(&dir, "slow", 12_800, 20);
+    fast_run(&config, &data, "60");
+    let first_run = mcap_files(&data.join("mcap"));
+    assert_eq!(first_run.len(), 3, "{first_run:?}");
+
+    // The restart, killed: a crash boundary, its file left unfinished.
+    let mut killed = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(["run", "--config", config.to_str().unwrap()])
+        .args(["--data-dir", data.to_str().unwrap(), "--quiet"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let second_run = loop {
+        let new: Vec<PathBuf> = mcap_files(&data.join("mcap"))
+            .into_iter()
+            .filter(|f| !first_run.contains(f))
+            .collect();
+        if new
+            .first()
+            .is_some_and(|f| std::fs::metadata(f).unwrap().len() > 20_000)
+        {
+            break new;
+        }
+        assert!(Instant::now() < deadline, "the restart logged nothing");
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    killed.kill().unwrap(); // SIGKILL
+    killed.wait().unwrap();
+
+    let mut given: Vec<PathBuf> = first_run.iter().chain(&second_run).cloned().collect();
+    given.reverse();
+    let out = dir.join("replay");
+    let (summary, stderr) = replay_json(&given, &out, &[]);
+
+    // Settings from the log: its rate, said on stderr.
+    assert_eq!(summary["settings_from"], "log", "{summary}");
+    assert!(
+        stderr.contains("settings from the log: motor-de at 12800 Hz"),
+        "{stderr}"
+    );
+    // Order: by run, then sequence; said because it is not the order given.
+    let expected: Vec<String> = first_run
+        .iter()
+        .chain(&second_run)
+        .map(|p| p.display().to_string())
+        .collect();
+    let order: Vec<String> = summary["order"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap().to_string())
+        .collect();
+    assert_eq!(order, expected);
+    assert_eq!(summary["reordered"], true);
+    assert!(stderr.contains("not in the order given"), "{stderr}");
+    // One run boundary, at the restart's file, said and in the summary.
+    assert_eq!(summary["run_boundaries"], 1, "{summary}");
+    let runs = summary["runs"].as_array().unwrap();
+    assert_eq!(runs[1]["first_file"], expected[3].as_str());
+    assert!(
+        stderr.contains(&format!("run boundary at {}", expected[3])),
+        "{stderr}"
+    );
+    assert_eq!(summary["gap_count"], 0, "{summary}");
+    assert_eq!(summary["unfinished_files"], 1, "{summary}");
+
+    // The rate came from the log: every replayed block at 12.8 kHz, and the flags of the live
+    // run at the same samples.
+    let replayed = mcap_files(&out);
+    let live: Vec<PathBuf> = first_run.iter().chain(&second_run).cloned().collect();
+    let live_flags = logged_flags(&live);
+    assert!(
+        live_flags.iter().any(|f| f.1 == "outer_race"),
+        "{live_flags:?}"
+    );
+    assert_eq!(logged_flags(&replayed), live_flags);
+    for m in read_messages(&replayed) {
+        if let PipelineMessage::Raw(b) = m.unwrap().message {
+            assert_eq!(b.sample_rate_hz, 12_800.0);
+        }
+    }
+
+    // Each run's output is dated with that run's UTC origin, read back by Python.
+    if let Some(py) = python_mcap() {
+        let mut seen = Vec::new();
+        for file in &replayed {
+            let read = python_metadata(&py, file);
+            let run = &read["metadata"]["bearingd.run"][0];
+            let origin: u64 = run["log_time_origin_ns"].as_str().unwrap().parse().unwrap();
+            let run_id: u64 = run["run_id"].as_str().unwrap().parse().unwrap();
+            let original = runs
+                .iter()
+                .find(|r| r["run_id"].as_u64() == Some(run_id))
+                .unwrap_or_else(|| panic!("{}: run {run_id} was not replayed", file.display()));
+            assert_eq!(original["origin_ns"].as_u64(), Some(origin));
+            let first = read["first_log_time"].as_u64().unwrap();
+            let last = read["last_log_time"].as_u64().unwrap();
+            // 2020-01-01 or later: real UTC, not 1970.
+            assert!(first >= 1_577_836_800_000_000_000, "{read}");
+            assert!(first >= origin && last <= origin + 61_000_000_000, "{read}");
+            seen.push(run_id);
+        }
+        // (File names sort by opening time, which interleaves the runs' files.)
+        seen.sort_unstable();
+        seen.dedup();
+        assert_eq!(seen.len(), 2, "{seen:?}");
+    }
+
+    // The same replay again writes the same bytes.
+    let first_out = dir.join("replay-first");
+    std::fs::rename(&out, &first_out).unwrap();
+    replay_json(&given, &out, &[]);
+    let again = mcap_files(&out);
+    assert_eq!(again.len(), replayed.len());
+    for (a, b) in mcap_files(&first_out).iter().zip(&again) {
+        assert_eq!(a.file_name(), b.file_name());
+        assert!(
+            std::fs::read(a).unwrap() == std::fs::read(b).unwrap(),
+            "{} differs between two replays",
+            b.display()
+        );
+    }
+
+    // Without the middle file of the first run: a gap of its length, and the file named.
+    let (summary, stderr) = replay_json(
+        &[first_run[2].clone(), first_run[0].clone()],
+        &dir.join("replay-gap"),
+        &[],
+    );
+    assert_eq!(summary["run_boundaries"], 0, "{summary}");
+    assert_eq!(summary["gap_count"], 1, "{summary}");
+    let gap = &summary["gaps"][0];
+    let seconds = gap["seconds"].as_f64().unwrap();
+    assert_eq!(seconds, gap["missing_samples"].as_f64().unwrap() / 12_800.0);
+    assert!((15.0..=25.0).contains(&seconds), "{gap}");
+    assert_eq!(summary["missing_files"][0]["sequence"], 2, "{summary}");
+    assert!(
+        stderr.contains("gap in motor-de/radial") && stderr.contains("file 2 of the run"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn replay_of_logs_with_different_settings_exits_2_naming_them_unless_config_is_given() {
+    let dir = scratch_dir("replay-disagree");
+    let slow = config_at(&dir, "slow", 12_800, 3600);
+    let fast = config_at(&dir, "fast", 25_600, 3600);
+    fast_run(&slow, &dir.join("a"), "1");
+    fast_run(&fast, &dir.join("b"), "1");
+    let files = [
+        mcap_files(&dir.join("a/mcap"))[0].clone(),
+        mcap_files(&dir.join("b/mcap"))[0].clone(),
+    ];
+    let names: Vec<&str> = files
+        .iter()
+        .map(|f| f.file_name().unwrap().to_str().unwrap())
+        .collect();
+    let out = bearingd(&[
+        "replay",
+        "--out",
+        dir.join("out").to_str().unwrap(),
+        "--quiet",
+        files[0].to_str().unwrap(),
+        files[1].to_str().unwrap(),
+    ]);
+    let stderr = stderr_of(&out);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("recorded with different settings")
+            && names.iter().all(|n| stderr.contains(n))
+            && stderr.contains("--config"),
+        "{stderr}"
+    );
+
+    // With --config: allowed, said, and what differs from the (first) log is named.
+    let (summary, stderr) = replay_json(
+        &files[..1],
+        &dir.join("out"),
+        &["--config", fast.to_str().unwrap()],
+    );
+    assert_eq!(summary["settings_from"], "config");
+    assert!(
+        stderr.contains("analysing with --config")
+            && stderr.contains("sample_rate_hz 25600 (log: 12800)"),
+        "{stderr}"
+    );
+    assert_eq!(summary["config_differences"].as_array().unwrap().len(), 1);
+}
+
+#[test]
+fn replay_of_a_log_without_metadata_says_it_falls_back_to_the_embedded_default() {
+    let dir = scratch_dir("replay-import");
+    let csv = dir.join("record.csv");
+    let simulated = bearingd(&[
+        "simulate",
+        "--duration",
+        "2",
+        "--fs",
+        "12800",
+        "--out",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(simulated.status.success(), "{}", stderr_of(&simulated));
+    let imported = bearingd(&[
+        "import",
+        csv.to_str().unwrap(),
+        "--fs",
+        "12800",
+        "--rpm",
+        "1772",
+        "--bearing",
+        "skf-6205-2rs",
+        "--out",
+        dir.join("log").to_str().unwrap(),
+    ]);
+    assert!(imported.status.success(), "{}", stderr_of(&imported));
+    let log = mcap_files(&dir.join("log"));
+    let (summary, stderr) = replay_json(&log, &dir.join("out"), &[]);
+    assert_eq!(summary["settings_from"], "embedded_default", "{summary}");
+    assert!(
+        stderr.contains("carries no settings") && stderr.contains("give --config"),
+        "{stderr}"
+    );
+    // The embedded default has no sensor `imported`: skipped, and said.
+    assert_eq!(
+        summary["unknown_channels"][0], "imported/radial",
+        "{summary}"
+    );
+
+    // With the config import wrote, it is replayed, and no fallback is said.
+    let (summary, stderr) = replay_json(
+        &log,
+        &dir.join("out2"),
+        &["--config", dir.join("log/replay.toml").to_str().unwrap()],
+    );
+    assert_eq!(summary["samples"], 2 * 12_800, "{summary}");
+    assert!(!stderr.contains("carries no settings"), "{stderr}");
+}
