@@ -49,6 +49,9 @@ pub struct RunStart {
     pub first_file: PathBuf,
 }
 
+/// Gives the sinks of a run, once its time origin is known.
+pub type OpenSinks<'a> = dyn FnMut(&RunStart) -> Result<Vec<Box<dyn Sink>>, SinkError> + 'a;
+
 /// Samples missing inside a run between two raw blocks of one channel.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Gap {
@@ -94,7 +97,7 @@ pub fn replay(
     plan: &ReplayPlan,
     config: &Config,
     options: &ReplayOptions,
-    open_sinks: &mut dyn FnMut(&RunStart) -> Result<Vec<Box<dyn Sink>>, SinkError>,
+    open_sinks: &mut OpenSinks<'_>,
     events: &Events,
 ) -> Result<ReplaySummary, ReplayError> {
     let started = Instant::now();
@@ -193,7 +196,7 @@ impl<'a> RunReplay<'a> {
 
     fn go(
         &mut self,
-        open_sinks: &mut dyn FnMut(&RunStart) -> Result<Vec<Box<dyn Sink>>, SinkError>,
+        open_sinks: &mut OpenSinks<'_>,
         summary: &mut ReplaySummary,
         progress: &mut Progress,
         events: &Events,
@@ -245,7 +248,7 @@ impl<'a> RunReplay<'a> {
 
     fn open(
         &mut self,
-        open_sinks: &mut dyn FnMut(&RunStart) -> Result<Vec<Box<dyn Sink>>, SinkError>,
+        open_sinks: &mut OpenSinks<'_>,
         summary: &mut ReplaySummary,
     ) -> Result<(), ReplayError> {
         let start = RunStart {

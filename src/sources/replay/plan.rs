@@ -297,7 +297,7 @@ fn geometry(b: &crate::bearing::BearingGeometry) -> String {
     )
 }
 
-/// `a, b and c` for the file names of `paths`.
+/// The file names of `paths`, comma-separated.
 pub fn file_list(paths: &[PathBuf]) -> String {
     paths
         .iter()
