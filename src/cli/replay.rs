@@ -210,7 +210,7 @@ fn progress_bar(args: &ReplayArgs, bytes: u64) -> Option<indicatif::ProgressBar>
     }
     let bar = indicatif::ProgressBar::new(bytes);
     let style = indicatif::ProgressStyle::with_template(
-        "replay {bar:30} {bytes}/{total_bytes} ({eta} left) {msg}",
+        "replay {bar:20} {bytes}/{total_bytes} ({eta}) {msg}",
     )
     .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
     bar.set_style(style);
@@ -228,7 +228,7 @@ fn bar_events(bar: indicatif::ProgressBar) -> Events {
         } => {
             bar.set_position(bytes_read);
             bar.set_message(format!(
-                "{sample_seconds:.0} s of signal, {flag_changes} flag changes"
+                "{sample_seconds:.0} s, {flag_changes} flag changes"
             ));
         }
         other => bar.suspend(|| eprintln!("{}", event_line(&other))),
