@@ -8,7 +8,7 @@ use crate::daemon::{run, DaemonEvent, Events, RunOptions};
 use crate::mcap_log::files::utc_text;
 use crate::messages::{HealthKind, PipelineMessage, SpeedSource};
 use crate::pipeline::{ChannelStatus, Sink, SinkError};
-use crate::sinks::mcap::{RecoveryAction, RecoveryReport};
+use crate::sinks::mcap::{LogNotice, RecoveryAction, RecoveryReport};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -184,15 +184,10 @@ pub(super) fn print_events() -> Events {
     })
 }
 
-/// How an event other than a status reads on stderr.
-fn event_line(event: &DaemonEvent) -> String {
-    match event {
-        DaemonEvent::Recovered(report) => recovery_line(report),
-        DaemonEvent::StaleLockTakenOver { path, previous } => format!(
-            "bearingd: {}: taken over from a previous bearingd that did not stop cleanly ({previous})",
-            path.display()
-        ),
-        DaemonEvent::Retention(report) => format!(
+/// How a notice of the MCAP log reads on stderr.
+fn log_notice_line(notice: &LogNotice) -> String {
+    match notice {
+        LogNotice::Retention(report) => format!(
             "bearingd: retention: deleted {} ({} bytes) to keep the logs within outputs.mcap_disk_budget_mb; {} bytes of logs left",
             report
                 .deleted
@@ -203,6 +198,40 @@ fn event_line(event: &DaemonEvent) -> String {
             report.bytes_deleted,
             report.total_bytes_after
         ),
+        LogNotice::Paused {
+            path,
+            error,
+            flushed_until_ns,
+        } => format!(
+            "bearingd: warning: logging PAUSED: {error}; {} is left unfinished (its data up to {} is kept and recovered when there is room); analysis and alerts go on; logging resumes by itself when the log directory has room again (free some space, or lower outputs.mcap_disk_budget_mb below the file system's size)",
+            path.display(),
+            utc_text(*flushed_until_ns)
+        ),
+        LogNotice::Resumed {
+            path,
+            messages_not_logged,
+            seconds_not_logged,
+        } => format!(
+            "bearingd: logging resumed in {}: {messages_not_logged} messages not logged during the pause, {seconds_not_logged:.1} s of signal lost",
+            path.display()
+        ),
+        LogNotice::PausedFileRecovered(report) => recovery_line(report),
+        LogNotice::PausedFileNotRecovered { path, error } => format!(
+            "bearingd: warning: {} (left by the pause) could not be recovered now: {error}; the next start recovers it",
+            path.display()
+        ),
+    }
+}
+
+/// How an event other than a status reads on stderr.
+fn event_line(event: &DaemonEvent) -> String {
+    match event {
+        DaemonEvent::Recovered(report) => recovery_line(report),
+        DaemonEvent::StaleLockTakenOver { path, previous } => format!(
+            "bearingd: {}: taken over from a previous bearingd that did not stop cleanly ({previous})",
+            path.display()
+        ),
+        DaemonEvent::Log(notice) => log_notice_line(notice),
         DaemonEvent::LoggingTo(path) => format!("bearingd: logging to {}", path.display()),
         DaemonEvent::AlertsOn { service, root } => format!(
             "bearingd: alerts on iceoryx2 service {service} (root {})",
