@@ -280,3 +280,86 @@ fn issue11_each_retention_deletion_is_a_log_message_in_the_mcap_file() {
         "the last deletion {last} is not in the surviving logs; noted: {noted:?}"
     );
 }
+
+/// Everything under `/dev/shm` named with `prefix`, and every file under `root`.
+fn iox_entries(prefix: &str, root: &Path) -> Vec<PathBuf> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+        for entry in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                walk(&path, out);
+            } else {
+                out.push(path);
+            }
+        }
+    }
+    let mut out: Vec<PathBuf> = std::fs::read_dir("/dev/shm")
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with(prefix))
+        .map(|e| e.path())
+        .collect();
+    walk(root, &mut out);
+    out.sort();
+    out
+}
+
+#[test]
+fn issue11_a_killed_daemons_iceoryx2_resources_are_removed_and_said_at_the_next_start() {
+    let dir = scratch_dir("lifecycle-dead-node");
+    let data = dir.join("data");
+    let pid = std::process::id();
+    let prefix = format!("bdlc{pid}_");
+    let root = PathBuf::from(format!("/dev/shm/bearingd-lifecycle-dead-{pid}"));
+    let config = config_file(&dir, |text| {
+        text.replace(
+            "\"/run/bearingd/iceoryx2\"",
+            &format!("\"{}\"", root.display()),
+        )
+    });
+    let run = |extra: &[&str]| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_bearingd"));
+        cmd.env("BEARINGD_IOX_PREFIX", &prefix)
+            .args(["run", "--config", config.to_str().unwrap(), "--quiet"])
+            .args(["--data-dir", data.to_str().unwrap()])
+            .args(extra);
+        cmd
+    };
+    let mut first = run(&[])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Up once its log has data (the alert service starts before the sources).
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while mcap_files(&data.join("mcap"))
+        .last()
+        .is_none_or(|f| std::fs::metadata(f).unwrap().len() < 20_000)
+    {
+        assert!(std::time::Instant::now() < deadline, "the first daemon did not start");
+        std::thread::sleep(std::time::Duration::from_millis(100));
+    }
+    first.kill().unwrap();
+    first.wait().unwrap();
+    let left = iox_entries(&prefix, &root);
+    assert!(!left.is_empty(), "the killed daemon left nothing to clean?");
+    let second = run(&["--fast", "--duration", "1"]).output().unwrap();
+    let stderr = stderr_of(&second);
+    assert!(second.status.success(), "{stderr}");
+    let said: Vec<&str> = stderr
+        .lines()
+        .filter(|l| l.contains("removed the stale resources of a dead node"))
+        .collect();
+    assert!(
+        said.iter()
+            .any(|l| l.contains(&format!("pid {}", first.id())) && l.contains("bearingd")),
+        "the cleanup of pid {} is not said: {stderr}",
+        first.id()
+    );
+    let still: Vec<&PathBuf> = left.iter().filter(|p| p.exists()).collect();
+    let _ = std::fs::remove_dir_all(&root);
+    assert!(
+        still.is_empty(),
+        "the killed daemon's iceoryx2 entries are still there: {still:?} (of {left:?})"
+    );
+}

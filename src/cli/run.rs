@@ -69,6 +69,12 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
             let mut config = config::load(path).map_err(CliError::input)?;
             if let Some(data) = &args.data_dir {
                 // The command line wins over the file, as without a config: the same layout.
+                // A fleet queue left at its default (under the state directory) follows it.
+                if let Some(fleet) = config.fleet.as_mut() {
+                    if fleet.queue_dir == config.outputs.state_dir.join("fleet") {
+                        fleet.queue_dir = data.join("state").join("fleet");
+                    }
+                }
                 config.outputs.state_dir = data.join("state");
                 config.outputs.mcap_dir = data.join("mcap");
                 eprintln!(
@@ -83,6 +89,15 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         None => embedded_default(args)?,
     };
     if let Some(broker) = &args.fleet {
+        if config.fleet.is_some() {
+            // The command line wins over the file, as --data-dir does, and says so.
+            eprintln!(
+                "bearingd: --fleet {broker} overrides the [fleet] section of {}",
+                args.config
+                    .as_deref()
+                    .map_or_else(|| "the config".into(), |p| p.display().to_string())
+            );
+        }
         let fleet =
             config::FleetConfig::for_broker(broker, &host_node_id(), &config.outputs.state_dir)
                 .map_err(CliError::input)?;
@@ -237,6 +252,23 @@ fn event_line(event: &DaemonEvent) -> String {
             "bearingd: alerts on iceoryx2 service {service} (root {})",
             root.display()
         ),
+        #[cfg(feature = "shm")]
+        DaemonEvent::DeadIoxNode { root, node } => match &node.removed {
+            Ok(()) => format!(
+                "bearingd: iceoryx2: removed the stale resources of a dead {} under {} (a process that did not stop cleanly)",
+                node.description,
+                root.display()
+            ),
+            Err(why) => format!(
+                "bearingd: warning: iceoryx2: the dead {} under {} left resources that could not be removed ({why}); remove them as the user that ran it",
+                node.description,
+                root.display()
+            ),
+        },
+        #[cfg(feature = "shm")]
+        DaemonEvent::DeadIoxNodesUnknown(why) => {
+            format!("bearingd: warning: iceoryx2: dead nodes not looked for: {why}")
+        }
         DaemonEvent::NoAlertService => {
             "bearingd: built without the `shm` feature: no iceoryx2 alerts are published".into()
         }

@@ -37,6 +37,16 @@ pub enum DaemonEvent {
     LoggingTo(PathBuf),
     /// The alert service is up.
     AlertsOn { service: String, root: PathBuf },
+    /// A dead iceoryx2 node under the root (a killed daemon's, or a killed publisher's): its
+    /// resources were removed at start, or could not be.
+    #[cfg(feature = "shm")]
+    DeadIoxNode {
+        root: PathBuf,
+        node: crate::iox::DeadNode,
+    },
+    /// The iceoryx2 nodes under the root could not be listed to find dead ones.
+    #[cfg(feature = "shm")]
+    DeadIoxNodesUnknown(String),
     /// This bearingd was built without iceoryx2: flags go to the log only.
     NoAlertService,
     /// An alert found the publisher's queue full.

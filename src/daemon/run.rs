@@ -294,6 +294,19 @@ type AlertSink = crate::sinks::alerts::AlertSink;
 #[cfg(feature = "shm")]
 fn start_alerts(config: &Config, events: &Events) -> Result<Option<AlertSink>, RunError> {
     let iox = crate::iox::IoxSettings::with_root(&config.outputs.iceoryx2_root);
+    // What a killed bearingd (or a killed publisher) left under this root, removed and said
+    // before this one creates its nodes.
+    match crate::iox::remove_dead_nodes(&iox) {
+        Ok(dead) => {
+            for node in dead {
+                events(DaemonEvent::DeadIoxNode {
+                    root: config.outputs.iceoryx2_root.clone(),
+                    node,
+                });
+            }
+        }
+        Err(e) => events(DaemonEvent::DeadIoxNodesUnknown(e.to_string())),
+    }
     let on_failure = {
         let events = events.clone();
         move |e| events(DaemonEvent::AlertFailed(e))

@@ -399,6 +399,8 @@ pub struct McapLogger {
     payload: Vec<u8>,
     /// What the retention pass at creation deleted, until the owner takes it.
     startup_retention: Option<RetentionReport>,
+    /// A file whose finishing failed in a rotation (a full disk), until [`Self::abandon`].
+    unfinished: Option<PathBuf>,
 }
 
 impl McapLogger {
@@ -418,6 +420,7 @@ impl McapLogger {
             topic: String::with_capacity(64),
             payload: Vec::with_capacity(64 * 1024),
             startup_retention: None,
+            unfinished: None,
         };
         logger.open_file(opened_at_ns)?;
         logger.startup_retention = Some(logger.apply_retention()?);
@@ -509,6 +512,9 @@ impl McapLogger {
     /// [`super::recover_file`] makes whole) and its path returned. [`Self::log`] then opens
     /// the next file; [`Self::reopen`] does so explicitly.
     pub fn abandon(&mut self) -> Option<PathBuf> {
+        if let Some(path) = self.unfinished.take() {
+            return Some(path);
+        }
         self.open.take().map(|file| {
             let path = file.path.clone();
             // Its stream refuses writes after the failure, so the writer's drop (which tries
@@ -608,7 +614,10 @@ impl McapLogger {
     /// budget.
     pub fn rotate(&mut self, opened_at_ns: u64) -> Result<RetentionReport> {
         if let Some(file) = self.open.take() {
-            let bytes = file.finish()?;
+            let path = file.path.clone();
+            let bytes = file
+                .finish()
+                .inspect_err(|_| self.unfinished = Some(path))?;
             self.stats.files_finished += 1;
             self.stats.finished_file_bytes += bytes;
         }
