@@ -269,7 +269,9 @@ pub const STATE_SCHEMA: &str = "bearingd.State";
 /// is the first message of that file (log time: the file's start), so that the file can be
 /// read alone; its messages are copies (their `end_sample` says when each was decided), kept
 /// on their own topic so that nothing counting transitions counts them twice.
-#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize, schemars::JsonSchema)]
+#[derive(
+    Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize, schemars::JsonSchema,
+)]
 pub struct StateSnapshot {
     pub flags: Vec<FlagMessage>,
     pub health: Vec<HealthMessage>,

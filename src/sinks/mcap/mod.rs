@@ -1,7 +1,10 @@
 //! The MCAP log as a sink: the writer with rotation and a disk budget ([`writer`]), the
 //! start-up recovery of files a crash left unfinished ([`recover`]), and [`McapSink`], which
 //! maps sample time to log time, flushes the open chunk every second of data (a crash loses at
-//! most that), recovers unfinished files at start, and finishes the file at shutdown. The
+//! most that), recovers unfinished files at start, and finishes the file at shutdown. It also
+//! begins every file opened by rotation with the current state (`/state`), writes a `/log`
+//! note for each retention deletion, and pauses logging when a write fails (a full disk)
+//! without stopping the pipeline, resuming when the directory has room ([`LogNotice`]). The
 //! format itself (schemas, topics, file names, reading back) is [`crate::mcap_log`]; what each
 //! file says about itself in MCAP metadata records is [`metadata`].
 
@@ -15,8 +18,8 @@ pub use recover::{
 pub use writer::{enforce_budget, LogStats, LoggerConfig, McapLogger, RetentionReport, TopicStats};
 
 use crate::config::Config;
-use crate::mcap_log::McapLogError;
 use crate::mcap_log::schema::{LogLevel, StateSnapshot};
+use crate::mcap_log::McapLogError;
 use crate::messages::{FlagMessage, HealthMessage, PipelineMessage, TwinMessage};
 use crate::pipeline::{Sink, SinkError};
 use std::collections::{BTreeMap, HashMap};
@@ -50,7 +53,10 @@ pub enum LogNotice {
     },
     /// A file left by a pause was recovered (or could not be, and waits for the next start).
     PausedFileRecovered(RecoveryReport),
-    PausedFileNotRecovered { path: PathBuf, error: String },
+    PausedFileNotRecovered {
+        path: PathBuf,
+        error: String,
+    },
 }
 
 /// A pause of the log after a write failed.
@@ -251,7 +257,7 @@ impl McapSink {
             pause.abandoned.push(path.clone());
             (self.on_notice)(&LogNotice::Paused {
                 path,
-                error: error.to_string(),
+                error: with_causes(error),
                 flushed_until_ns: pause.flushed_until_ns,
             });
         }
@@ -274,16 +280,7 @@ impl McapSink {
             pause.messages += 1;
             return false;
         }
-        let mut notices = Vec::new();
-        for path in std::mem::take(&mut pause.abandoned) {
-            match recover_file(&path) {
-                Ok(report) => notices.push(LogNotice::PausedFileRecovered(report)),
-                Err(e) => notices.push(LogNotice::PausedFileNotRecovered {
-                    path,
-                    error: e.to_string(),
-                }),
-            }
-        }
+        let notices = recover_abandoned(std::mem::take(&mut pause.abandoned));
         let opened = logger
             .reopen(at_ns)
             .and_then(|()| logger.write_state(&self.state.snapshot(), at_ns))
@@ -291,11 +288,11 @@ impl McapSink {
         for notice in &notices {
             (self.on_notice)(notice);
         }
-        if let Err(e) = opened {
+        if opened.is_err() {
+            // Still no room after all (the free space was taken meanwhile): paused again.
             if let Some(path) = logger.abandon() {
                 pause.abandoned.push(path);
             }
-            let _ = e;
             pause.messages += 1;
             return false;
         }
@@ -307,7 +304,10 @@ impl McapSink {
              failure"
         );
         let noted = logger.note(LogLevel::Warning, &text, at_ns);
-        let path = logger.current_path().map(Path::to_path_buf).unwrap_or_default();
+        let path = logger
+            .current_path()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
         self.pause = None;
         if let Err(e) = noted {
             self.pause(&e, at_ns);
@@ -321,6 +321,36 @@ impl McapSink {
         });
         true
     }
+}
+
+/// An error's message followed by those of its causes that it does not already say (the
+/// `mcap` crate's I/O error hides the OS's reason, e.g. "No space left on device").
+fn with_causes(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut cause = error.source();
+    while let Some(inner) = cause {
+        let said = inner.to_string();
+        if !text.contains(&said) {
+            text.push_str(": ");
+            text.push_str(&said);
+        }
+        cause = inner.source();
+    }
+    text
+}
+
+/// Recovers the files a pause left unfinished; what became of each.
+fn recover_abandoned(paths: Vec<PathBuf>) -> Vec<LogNotice> {
+    paths
+        .into_iter()
+        .map(|path| match recover_file(&path) {
+            Ok(report) => LogNotice::PausedFileRecovered(report),
+            Err(e) => LogNotice::PausedFileNotRecovered {
+                path,
+                error: e.to_string(),
+            },
+        })
+        .collect()
 }
 
 /// Free bytes for an unprivileged writer in `dir`'s file system; `None` if it cannot be told.
@@ -353,14 +383,7 @@ impl Sink for McapSink {
 
     fn finish(&mut self) -> Result<(), SinkError> {
         if let Some(pause) = self.pause.take() {
-            for path in pause.abandoned {
-                let notice = match recover_file(&path) {
-                    Ok(report) => LogNotice::PausedFileRecovered(report),
-                    Err(e) => LogNotice::PausedFileNotRecovered {
-                        path,
-                        error: e.to_string(),
-                    },
-                };
+            for notice in recover_abandoned(pause.abandoned) {
                 (self.on_notice)(&notice);
             }
         }

@@ -275,7 +275,11 @@ impl OpenFile {
                 source,
             };
             let (topic, name, schema) = match side {
-                Side::Log => (schema::LOG_TOPIC, schema::LOG_SCHEMA, schema::log_json_schema()),
+                Side::Log => (
+                    schema::LOG_TOPIC,
+                    schema::LOG_SCHEMA,
+                    schema::log_json_schema(),
+                ),
                 Side::State => (
                     schema::STATE_TOPIC,
                     schema::STATE_SCHEMA,
