@@ -8,7 +8,7 @@ use crate::daemon::{run, DaemonEvent, Events, RunOptions};
 use crate::mcap_log::files::utc_text;
 use crate::messages::{HealthKind, PipelineMessage, SpeedSource};
 use crate::pipeline::{ChannelStatus, Sink, SinkError};
-use crate::sinks::mcap::{RecoveryAction, RecoveryReport};
+use crate::sinks::mcap::{LogNotice, RecoveryAction, RecoveryReport};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -69,6 +69,12 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
             let mut config = config::load(path).map_err(CliError::input)?;
             if let Some(data) = &args.data_dir {
                 // The command line wins over the file, as without a config: the same layout.
+                // A fleet queue left at its default (under the state directory) follows it.
+                if let Some(fleet) = config.fleet.as_mut() {
+                    if fleet.queue_dir == config.outputs.state_dir.join("fleet") {
+                        fleet.queue_dir = data.join("state").join("fleet");
+                    }
+                }
                 config.outputs.state_dir = data.join("state");
                 config.outputs.mcap_dir = data.join("mcap");
                 eprintln!(
@@ -83,6 +89,15 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         None => embedded_default(args)?,
     };
     if let Some(broker) = &args.fleet {
+        if config.fleet.is_some() {
+            // The command line wins over the file, as --data-dir does, and says so.
+            eprintln!(
+                "bearingd: --fleet {broker} overrides the [fleet] section of {}",
+                args.config
+                    .as_deref()
+                    .map_or_else(|| "the config".into(), |p| p.display().to_string())
+            );
+        }
         let fleet =
             config::FleetConfig::for_broker(broker, &host_node_id(), &config.outputs.state_dir)
                 .map_err(CliError::input)?;
@@ -184,15 +199,10 @@ pub(super) fn print_events() -> Events {
     })
 }
 
-/// How an event other than a status reads on stderr.
-pub(super) fn event_line(event: &DaemonEvent) -> String {
-    match event {
-        DaemonEvent::Recovered(report) => recovery_line(report),
-        DaemonEvent::StaleLockTakenOver { path, previous } => format!(
-            "bearingd: {}: taken over from a previous bearingd that did not stop cleanly ({previous})",
-            path.display()
-        ),
-        DaemonEvent::Retention(report) => format!(
+/// How a notice of the MCAP log reads on stderr.
+fn log_notice_line(notice: &LogNotice) -> String {
+    match notice {
+        LogNotice::Retention(report) => format!(
             "bearingd: retention: deleted {} ({} bytes) to keep the logs within outputs.mcap_disk_budget_mb; {} bytes of logs left",
             report
                 .deleted
@@ -203,11 +213,62 @@ pub(super) fn event_line(event: &DaemonEvent) -> String {
             report.bytes_deleted,
             report.total_bytes_after
         ),
+        LogNotice::Paused {
+            path,
+            error,
+            flushed_until_ns,
+        } => format!(
+            "bearingd: warning: logging PAUSED: {error}; {} is left unfinished (its data up to {} is kept and recovered when there is room); analysis and alerts go on; logging resumes by itself when the log directory has room again (free some space, or lower outputs.mcap_disk_budget_mb below the file system's size)",
+            path.display(),
+            utc_text(*flushed_until_ns)
+        ),
+        LogNotice::Resumed {
+            path,
+            messages_not_logged,
+            seconds_not_logged,
+        } => format!(
+            "bearingd: logging resumed in {}: {messages_not_logged} messages not logged during the pause, {seconds_not_logged:.1} s of signal lost",
+            path.display()
+        ),
+        LogNotice::PausedFileRecovered(report) => recovery_line(report),
+        LogNotice::PausedFileNotRecovered { path, error } => format!(
+            "bearingd: warning: {} (left by the pause) could not be recovered now: {error}; the next start recovers it",
+            path.display()
+        ),
+    }
+}
+
+/// How an event other than a status reads on stderr.
+pub(super) fn event_line(event: &DaemonEvent) -> String {
+    match event {
+        DaemonEvent::Recovered(report) => recovery_line(report),
+        DaemonEvent::StaleLockTakenOver { path, previous } => format!(
+            "bearingd: {}: taken over from a previous bearingd that did not stop cleanly ({previous})",
+            path.display()
+        ),
+        DaemonEvent::Log(notice) => log_notice_line(notice),
         DaemonEvent::LoggingTo(path) => format!("bearingd: logging to {}", path.display()),
         DaemonEvent::AlertsOn { service, root } => format!(
             "bearingd: alerts on iceoryx2 service {service} (root {})",
             root.display()
         ),
+        #[cfg(feature = "shm")]
+        DaemonEvent::DeadIoxNode { root, node } => match &node.removed {
+            Ok(()) => format!(
+                "bearingd: iceoryx2: removed the stale resources of a dead {} under {} (a process that did not stop cleanly)",
+                node.description,
+                root.display()
+            ),
+            Err(why) => format!(
+                "bearingd: warning: iceoryx2: the dead {} under {} left resources that could not be removed ({why}); remove them as the user that ran it",
+                node.description,
+                root.display()
+            ),
+        },
+        #[cfg(feature = "shm")]
+        DaemonEvent::DeadIoxNodesUnknown(why) => {
+            format!("bearingd: warning: iceoryx2: dead nodes not looked for: {why}")
+        }
         DaemonEvent::NoAlertService => {
             "bearingd: built without the `shm` feature: no iceoryx2 alerts are published".into()
         }

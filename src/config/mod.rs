@@ -134,10 +134,12 @@ impl Config {
     /// root of its own, so that a user without root can run it and `bearingd alerts
     /// --data-dir` finds the same root.
     ///
-    /// The root is `/tmp/bearingd-iox-<hash of the absolute data directory>` rather than
+    /// The root is `/dev/shm/bearingd-iox-<hash of the absolute data directory>` rather than
     /// inside the data directory: iceoryx2's socket paths below the root must fit in 108
-    /// bytes, which a deep working directory would exceed ([`MAX_IOX_ROOT_LEN`]). /tmp is fine
-    /// here: this is not the systemd service, whose config keeps it out of a private /tmp.
+    /// bytes, which a deep working directory would exceed ([`MAX_IOX_ROOT_LEN`]). Not under
+    /// /tmp, which the config refuses (systemd's `PrivateTmp=` hides it from subscribers): the
+    /// default uses only what a config file may say. /dev/shm is writable by every user, is
+    /// where iceoryx2 keeps its shared memory anyway, and is the same for every process.
     pub fn embedded_in(data_dir: &Path) -> Result<Config, String> {
         let mut config = Config::default_embedded().map_err(|e| e.to_string())?;
         let absolute = std::path::absolute(data_dir).map_err(|e| {
@@ -149,7 +151,7 @@ impl Config {
         config.outputs.state_dir = data_dir.join("state");
         config.outputs.mcap_dir = data_dir.join("mcap");
         config.outputs.iceoryx2_root = std::path::PathBuf::from(format!(
-            "/tmp/bearingd-iox-{:016x}",
+            "/dev/shm/bearingd-iox-{:016x}",
             fnv1a(absolute.as_os_str().as_encoded_bytes())
         ));
         Ok(config)

@@ -8,7 +8,7 @@ use crate::messages::ChannelId;
 use crate::pipeline::ChannelStatus;
 #[cfg(feature = "shm")]
 use crate::sinks::alerts::{AlertDropped, AlertError};
-use crate::sinks::mcap::{RecoveryReport, RetentionReport};
+use crate::sinks::mcap::{LogNotice, RecoveryReport};
 use crate::sinks::systemd::NotifyError;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -29,13 +29,24 @@ pub enum DaemonEvent {
     StaleLockTakenOver { path: PathBuf, previous: String },
     /// A file a crash left unfinished was recovered at start.
     Recovered(RecoveryReport),
-    /// The disk budget (`outputs.mcap_disk_budget_mb`) made retention delete the oldest log
-    /// files.
-    Retention(RetentionReport),
+    /// What the MCAP log tells: retention deleted the oldest files (the disk budget,
+    /// `outputs.mcap_disk_budget_mb`), a write failed and logging is paused (a full disk), it
+    /// goes on.
+    Log(LogNotice),
     /// The MCAP log's first file is open.
     LoggingTo(PathBuf),
     /// The alert service is up.
     AlertsOn { service: String, root: PathBuf },
+    /// A dead iceoryx2 node under the root (a killed daemon's, or a killed publisher's): its
+    /// resources were removed at start, or could not be.
+    #[cfg(feature = "shm")]
+    DeadIoxNode {
+        root: PathBuf,
+        node: crate::iox::DeadNode,
+    },
+    /// The iceoryx2 nodes under the root could not be listed to find dead ones.
+    #[cfg(feature = "shm")]
+    DeadIoxNodesUnknown(String),
     /// This bearingd was built without iceoryx2: flags go to the log only.
     NoAlertService,
     /// An alert found the publisher's queue full.

@@ -130,6 +130,9 @@ pub async fn run(
 ) -> Result<RunSummary, RunError> {
     let state_dir = prepare_state_dir(&config)?;
     let _locks = lock_data_dirs(&config, &events)?;
+    // The sources' devices before the log: a missing CAN interface must stop the start
+    // before a file exists (it left an empty log behind on every restart).
+    let can_sources = open_can_sources(&config)?;
     // Wall time of sample 0: the log's time base, and the fleet bridge's.
     let origin_ns = wall_clock_now_ns();
     sinks.push(Box::new(open_log(&config, origin_ns, &events)?));
@@ -171,7 +174,14 @@ pub async fn run(
 
     let (stop_tx, stop_rx) = watch::channel(false);
     let mut sources = JoinSet::new();
-    let live = start_live_sources(&config, &input_tx, &stop_rx, &mut sources, &events)?;
+    let live = start_live_sources(
+        &config,
+        can_sources,
+        &input_tx,
+        &stop_rx,
+        &mut sources,
+        &events,
+    )?;
     start_simulated(&config, &options, &input_tx, &stop_rx, &mut sources);
     // A weak handle on the analysis queue, to see whether inputs wait there; it does not keep
     // the queue open, so the analysis thread still ends when the sources do.
@@ -255,7 +265,7 @@ fn open_log(config: &Config, origin_ns: u64, events: &Events) -> Result<McapSink
     let (log, recovered) = McapSink::for_config(config, origin_ns)?;
     let log = {
         let events = events.clone();
-        log.on_retention(move |report| events(DaemonEvent::Retention(report.clone())))
+        log.on_notice(move |notice| events(DaemonEvent::Log(notice.clone())))
     };
     for report in recovered {
         events(DaemonEvent::Recovered(report));
@@ -284,6 +294,19 @@ type AlertSink = crate::sinks::alerts::AlertSink;
 #[cfg(feature = "shm")]
 fn start_alerts(config: &Config, events: &Events) -> Result<Option<AlertSink>, RunError> {
     let iox = crate::iox::IoxSettings::with_root(&config.outputs.iceoryx2_root);
+    // What a killed bearingd (or a killed publisher) left under this root, removed and said
+    // before this one creates its nodes.
+    match crate::iox::remove_dead_nodes(&iox) {
+        Ok(dead) => {
+            for node in dead {
+                events(DaemonEvent::DeadIoxNode {
+                    root: config.outputs.iceoryx2_root.clone(),
+                    node,
+                });
+            }
+        }
+        Err(e) => events(DaemonEvent::DeadIoxNodesUnknown(e.to_string())),
+    }
     let on_failure = {
         let events = events.clone();
         move |e| events(DaemonEvent::AlertFailed(e))
@@ -507,9 +530,57 @@ fn sink_thread(
     }
 }
 
-/// Starts the SocketCAN and iceoryx2 sources of the config; `true` if there is any.
+/// A CAN interface of the config with its socket open, not yet read.
+#[cfg(feature = "can")]
+struct OpenedCan {
+    interface: String,
+    map: crate::sources::live::NodeMap,
+    source: crate::sources::can::CanSource,
+}
+
+/// Without the `can` feature there is nothing to open.
+#[cfg(not(feature = "can"))]
+enum OpenedCan {}
+
+/// Opens the socket of every CAN interface of the config, so that a missing interface is an
+/// error before anything is written (the log's first file is opened after this).
+fn open_can_sources(config: &Config) -> Result<Vec<OpenedCan>, RunError> {
+    let mut opened = Vec::new();
+    for (interface, map) in can_interfaces(config) {
+        #[cfg(feature = "can")]
+        {
+            use crate::sources::can;
+            let source = can::open(can::CanSourceConfig {
+                interface: interface.clone(),
+                silence_timeout: SENSOR_TIMEOUT,
+                receive_buffer_bytes: 4 << 20,
+                capture: None,
+                capture_frames: 0,
+                stats_interval: Some(Duration::from_secs_f64(config.outputs.status_interval_s)),
+            })?;
+            opened.push(OpenedCan {
+                interface,
+                map,
+                source,
+            });
+        }
+        #[cfg(not(feature = "can"))]
+        {
+            let _ = (map, &mut opened);
+            return Err(RunError::NotBuilt {
+                what: format!("CAN interface {interface}"),
+                feature: "can",
+            });
+        }
+    }
+    Ok(opened)
+}
+
+/// Starts the SocketCAN sources opened by [`open_can_sources`] and the iceoryx2 sources of
+/// the config; `true` if there is any.
 fn start_live_sources(
     config: &Config,
+    can_sources: Vec<OpenedCan>,
     inputs: &async_mpsc::Sender<Arrived>,
     stop: &watch::Receiver<bool>,
     tasks: &mut JoinSet<()>,
@@ -524,19 +595,15 @@ fn start_live_sources(
     let stopped = |mut stop: watch::Receiver<bool>| async move {
         let _ = stop.wait_for(|s| *s).await;
     };
-    for (interface, map) in can_interfaces(config) {
+    for opened in can_sources {
         #[cfg(feature = "can")]
         {
             any = true;
-            use crate::sources::can;
-            let source = can::open(can::CanSourceConfig {
-                interface: interface.clone(),
-                silence_timeout: SENSOR_TIMEOUT,
-                receive_buffer_bytes: 4 << 20,
-                capture: None,
-                capture_frames: 0,
-                stats_interval: Some(status_interval),
-            })?;
+            let OpenedCan {
+                interface,
+                map,
+                source,
+            } = opened;
             let (events_tx, events_rx) = async_mpsc::channel(ANALYSIS_QUEUE);
             let shutdown = stopped(stop.clone());
             let events = events.clone();
@@ -556,13 +623,7 @@ fn start_live_sources(
             ));
         }
         #[cfg(not(feature = "can"))]
-        {
-            let _ = (map, inputs, stop, tasks, events);
-            return Err(RunError::NotBuilt {
-                what: format!("CAN interface {interface}"),
-                feature: "can",
-            });
-        }
+        match opened {}
     }
     for (sensor, map) in shm_sensors(config) {
         #[cfg(feature = "shm")]

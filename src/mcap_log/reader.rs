@@ -10,7 +10,7 @@ use prost::Message as _;
 
 use super::error::{McapLogError, Result};
 use super::scan::{ScanOutcome, ScannedRecord, Scanner};
-use super::schema::{JsonKind, RawBlockPb, RAW_BLOCK_SCHEMA};
+use super::schema::{JsonKind, RawBlockPb, LOG_SCHEMA, RAW_BLOCK_SCHEMA, STATE_SCHEMA};
 use crate::messages::{PipelineMessage, RawBlock};
 
 /// One message read back, with its MCAP envelope.
@@ -67,6 +67,8 @@ struct ChannelInfo {
 enum Decoder {
     Raw,
     Json(JsonKind),
+    /// A channel for people and viewers (`/log`, `/state`), not a pipeline message.
+    Skip,
     Unknown,
 }
 
@@ -162,6 +164,10 @@ impl LogReader {
             } => {
                 let decoder = if name == RAW_BLOCK_SCHEMA && encoding == "protobuf" {
                     Decoder::Raw
+                } else if name == LOG_SCHEMA || name == STATE_SCHEMA {
+                    // The daemon's notes and state snapshots: for people and viewers, not
+                    // pipeline messages.
+                    Decoder::Skip
                 } else if encoding == "jsonschema" {
                     JsonKind::from_schema_name(&name).map_or(Decoder::Unknown, Decoder::Json)
                 } else {
@@ -180,6 +186,7 @@ impl LogReader {
                 let decoder = match self.schemas.get(&schema_id) {
                     Some(Decoder::Raw) if message_encoding == "protobuf" => Decoder::Raw,
                     Some(Decoder::Json(k)) if message_encoding == "json" => Decoder::Json(*k),
+                    Some(Decoder::Skip) => Decoder::Skip,
                     _ => Decoder::Unknown,
                 };
                 self.channels.insert(id, ChannelInfo { topic, decoder });
@@ -203,7 +210,9 @@ impl LogReader {
                         reason: "message on an unknown channel".into(),
                     }));
                 };
-                if self.raw_only && !matches!(channel.decoder, Decoder::Raw) {
+                if matches!(channel.decoder, Decoder::Skip)
+                    || (self.raw_only && !matches!(channel.decoder, Decoder::Raw))
+                {
                     return None;
                 }
                 let decoded: std::result::Result<PipelineMessage, String> = match channel.decoder {
@@ -216,6 +225,7 @@ impl LogReader {
                         .map(PipelineMessage::Raw),
                     Decoder::Json(kind) => decode_json(kind, &data).map_err(|e| e.to_string()),
                     Decoder::Unknown => Err("channel has no schema this reader knows".into()),
+                    Decoder::Skip => return None,
                 };
                 match decoded {
                     Ok(message) => {

@@ -203,6 +203,95 @@ impl JsonKind {
     }
 }
 
+/// The topic of the daemon's notes about its own logs (retention, a pause for a full disk).
+pub const LOG_TOPIC: &str = "/log";
+/// Foxglove's well-known log message, so that Foxglove's Log panel shows the notes.
+pub const LOG_SCHEMA: &str = "foxglove.Log";
+
+/// Severity of a `/log` note, with `foxglove.Log`'s numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LogLevel {
+    Info = 2,
+    Warning = 3,
+    Error = 4,
+}
+
+/// The JSON Schema of a `foxglove.Log` message (the subset we write: every field).
+pub fn log_json_schema() -> Value {
+    json!({
+        "$schema": "https://json-schema.org/draft/2020-12/schema",
+        "title": LOG_SCHEMA,
+        "description": "A note of the daemon about its logs (Foxglove's foxglove.Log)",
+        "type": "object",
+        "properties": {
+            "timestamp": {
+                "type": "object",
+                "properties": {
+                    "sec": {"type": "integer", "minimum": 0},
+                    "nsec": {"type": "integer", "minimum": 0}
+                },
+                "required": ["sec", "nsec"]
+            },
+            "level": {
+                "type": "integer",
+                "description": "0 unknown, 1 debug, 2 info, 3 warning, 4 error, 5 fatal"
+            },
+            "message": {"type": "string"},
+            "name": {"type": "string"},
+            "file": {"type": "string"},
+            "line": {"type": "integer", "minimum": 0}
+        },
+        "required": ["timestamp", "level", "message", "name", "file", "line"]
+    })
+}
+
+/// One `foxglove.Log` message, serialized: `text` at `time_ns`, named `bearingd`.
+pub fn log_note(level: LogLevel, text: &str, time_ns: u64) -> Vec<u8> {
+    json!({
+        "timestamp": {"sec": time_ns / 1_000_000_000, "nsec": time_ns % 1_000_000_000},
+        "level": level as u8,
+        "message": text,
+        "name": "bearingd",
+        "file": "",
+        "line": 0
+    })
+    .to_string()
+    .into_bytes()
+}
+
+/// The topic of the state snapshot that begins every file opened by rotation.
+pub const STATE_TOPIC: &str = "/state";
+/// Schema name of [`StateSnapshot`].
+pub const STATE_SCHEMA: &str = "bearingd.State";
+
+/// What the daemon holds as current when a file is opened by rotation: per channel, the last
+/// flag change of each fault, the last health message of each kind and the last twin fit. It
+/// is the first message of that file (log time: the file's start), so that the file can be
+/// read alone; its messages are copies (their `end_sample` says when each was decided), kept
+/// on their own topic so that nothing counting transitions counts them twice.
+#[derive(
+    Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize, schemars::JsonSchema,
+)]
+pub struct StateSnapshot {
+    pub flags: Vec<FlagMessage>,
+    pub health: Vec<HealthMessage>,
+    pub twin: Vec<TwinMessage>,
+}
+
+impl StateSnapshot {
+    /// The JSON Schema of the snapshot, generated like the other JSON kinds'.
+    pub fn json_schema() -> Value {
+        let generator = SchemaSettings::draft2020_12()
+            .for_serialize()
+            .with(|s| s.inline_subschemas = true)
+            .with_transform(nullable_numbers)
+            .into_generator();
+        let mut schema = generator.into_root_schema_for::<StateSnapshot>();
+        schema.insert("title".into(), STATE_SCHEMA.into());
+        schema.to_value()
+    }
+}
+
 /// `serde_json` writes a non-finite float as `null`: every `number` also admits `null`.
 fn nullable_numbers(schema: &mut Schema) {
     if schema.get("type") == Some(&Value::from("number")) {

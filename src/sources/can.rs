@@ -42,7 +42,7 @@ pub struct CanSourceConfig {
 /// Why the CAN source could not run.
 #[derive(Debug, thiserror::Error)]
 pub enum CanSourceError {
-    #[error("CAN interface {interface}: cannot open a CAN FD raw socket: {source} (does the interface exist and is it up? `ip link show {interface}`)")]
+    #[error("CAN interface {interface}: cannot open a CAN FD raw socket: {source}; check that it exists and is up (`ip link show {interface}`; a virtual bus for tests: `ip link add {interface} type vcan && ip link set {interface} up`) or name another interface in sensors[].can.interface; nothing was written")]
     Open {
         interface: String,
         source: std::io::Error,

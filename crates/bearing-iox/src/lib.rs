@@ -110,9 +110,53 @@ impl ServiceNames {
     }
 }
 
+/// A node of a process that died (`kill -9`, a power cut) without removing its iceoryx2
+/// resources, found at start by [`remove_dead_nodes`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct DeadNode {
+    /// Its name, process id and executable, as far as iceoryx2 kept them.
+    pub description: String,
+    /// `Err` with iceoryx2's reason when its resources could not be removed.
+    pub removed: Result<(), String>,
+}
+
 #[cfg(feature = "iceoryx2")]
-/// An iceoryx2 node with bearingd's settings.
-pub fn create_node(settings: &IoxSettings) -> Result<Node<ipc::Service>, ShmError> {
+/// Removes the resources (shared memory, its node and service entries under the root) of every
+/// dead node under these settings, so that a killed daemon leaves nothing behind once the next
+/// starts; returns what was found, to be said. iceoryx2 would also do it silently on the next
+/// node's creation; doing it first tells the operator.
+pub fn remove_dead_nodes(settings: &IoxSettings) -> Result<Vec<DeadNode>, ShmError> {
+    use iceoryx2::node::NodeView as _;
+    let config = node_config(settings)?;
+    let mut dead = Vec::new();
+    Node::<ipc::Service>::list(&config, |state| {
+        if let NodeState::Dead(view) = state {
+            let description = match view.details() {
+                Some(d) => format!(
+                    "node {:?} of pid {} ({})",
+                    d.name().as_str(),
+                    d.process_id(),
+                    d.executable()
+                ),
+                None => format!("node {:?}", view.id()),
+            };
+            let removed = view
+                .try_remove_stale_resources()
+                .map_err(|e| format!("{e:?}"));
+            dead.push(DeadNode {
+                description,
+                removed,
+            });
+        }
+        CallbackProgression::Continue
+    })
+    .map_err(|e| ShmError::Node(format!("cannot list the nodes to find dead ones: {e:?}")))?;
+    Ok(dead)
+}
+
+#[cfg(feature = "iceoryx2")]
+/// iceoryx2's config with bearingd's settings.
+fn node_config(settings: &IoxSettings) -> Result<Config, ShmError> {
     let mut config = Config::default();
     if let Some(prefix) = &settings.prefix {
         config.global.prefix = FileName::new(prefix.as_bytes()).map_err(|_| ShmError::Setting {
@@ -127,6 +171,13 @@ pub fn create_node(settings: &IoxSettings) -> Result<Node<ipc::Service>, ShmErro
         })?;
         config.global.set_root_path(&path);
     }
+    Ok(config)
+}
+
+#[cfg(feature = "iceoryx2")]
+/// An iceoryx2 node with bearingd's settings.
+pub fn create_node(settings: &IoxSettings) -> Result<Node<ipc::Service>, ShmError> {
+    let config = node_config(settings)?;
     NodeBuilder::new()
         .config(&config)
         .signal_handling_mode(SignalHandlingMode::Disabled)

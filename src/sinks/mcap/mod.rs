@@ -1,7 +1,10 @@
 //! The MCAP log as a sink: the writer with rotation and a disk budget ([`writer`]), the
 //! start-up recovery of files a crash left unfinished ([`recover`]), and [`McapSink`], which
 //! maps sample time to log time, flushes the open chunk every second of data (a crash loses at
-//! most that), recovers unfinished files at start, and finishes the file at shutdown. The
+//! most that), recovers unfinished files at start, and finishes the file at shutdown. It also
+//! begins every file opened by rotation with the current state (`/state`), writes a `/log`
+//! note for each retention deletion, and pauses logging when a write fails (a full disk)
+//! without stopping the pipeline, resuming when the directory has room ([`LogNotice`]). The
 //! format itself (schemas, topics, file names, reading back) is [`crate::mcap_log`]; what each
 //! file says about itself in MCAP metadata records is [`metadata`].
 
@@ -15,14 +18,92 @@ pub use recover::{
 pub use writer::{enforce_budget, LogStats, LoggerConfig, McapLogger, RetentionReport, TopicStats};
 
 use crate::config::Config;
+use crate::mcap_log::schema::{LogLevel, StateSnapshot};
 use crate::mcap_log::McapLogError;
-use crate::messages::PipelineMessage;
+use crate::messages::{FlagMessage, HealthMessage, PipelineMessage, TwinMessage};
 use crate::pipeline::{Sink, SinkError};
-use std::collections::HashMap;
-use std::path::Path;
+use std::collections::{BTreeMap, HashMap};
+use std::path::{Path, PathBuf};
 
 /// Nanoseconds of log time between two flushes.
 const FLUSH_EVERY_NS: u64 = 1_000_000_000;
+/// While logging is paused (a full disk), how often (log time) free space is looked at.
+const RETRY_EVERY_NS: u64 = 1_000_000_000;
+
+/// What the log tells its owner (the daemon says it to the operator).
+#[derive(Debug, Clone)]
+pub enum LogNotice {
+    /// Retention deleted the oldest files (at start, or after a rotation).
+    Retention(RetentionReport),
+    /// Writing the open file failed (a full disk): it is left unfinished (recovered later),
+    /// logging is paused; the analysis and the alerts go on.
+    Paused {
+        path: PathBuf,
+        error: String,
+        /// Log time of the last flush that reached the file: a crash-safe prefix up to here.
+        flushed_until_ns: u64,
+    },
+    /// Logging goes on in `path` after a pause.
+    Resumed {
+        path: PathBuf,
+        /// Messages the pipeline made while paused, not logged.
+        messages_not_logged: u64,
+        /// Log time from the last flush before the pause to the first message logged after it.
+        seconds_not_logged: f64,
+    },
+    /// A file left by a pause was recovered (or could not be, and waits for the next start).
+    PausedFileRecovered(RecoveryReport),
+    PausedFileNotRecovered {
+        path: PathBuf,
+        error: String,
+    },
+}
+
+/// A pause of the log after a write failed.
+struct Pause {
+    /// Log time of the last flush that reached the disk before the failure.
+    flushed_until_ns: u64,
+    messages: u64,
+    next_try_ns: u64,
+    /// Files left unfinished by the failure, to recover when there is room.
+    abandoned: Vec<PathBuf>,
+}
+
+/// The current state per channel (last flag change per fault, last health per kind, last
+/// twin fit), which begins every file opened by rotation.
+#[derive(Default)]
+struct CurrentState {
+    flags: BTreeMap<String, FlagMessage>,
+    health: BTreeMap<String, HealthMessage>,
+    twin: BTreeMap<String, TwinMessage>,
+}
+
+impl CurrentState {
+    fn note(&mut self, message: &PipelineMessage) {
+        match message {
+            PipelineMessage::Flag(m) => {
+                self.flags
+                    .insert(format!("{}/{:?}", m.channel, m.fault), m.clone());
+            }
+            PipelineMessage::Health(m) => {
+                self.health
+                    .insert(format!("{}/{:?}", m.channel, m.kind), m.clone());
+            }
+            PipelineMessage::Twin(m) => {
+                self.twin.insert(m.channel.to_string(), m.clone());
+            }
+            _ => {}
+        }
+    }
+
+    fn snapshot(&self) -> StateSnapshot {
+        StateSnapshot {
+            flags: self.flags.values().cloned().collect(),
+            health: self.health.values().cloned().collect(),
+            twin: self.twin.values().cloned().collect(),
+        }
+    }
+}
 
 pub struct McapSink {
     logger: Option<McapLogger>,
@@ -32,10 +113,14 @@ pub struct McapSink {
     rates: HashMap<String, f64>,
     next_flush_ns: u64,
     last_ns: u64,
+    /// Log time of the last flush that reached the file.
+    flushed_ns: u64,
     errors: Vec<McapLogError>,
     pub messages: u64,
-    /// Told of every retention pass that deleted files (the operator must know).
-    on_retention: Box<dyn Fn(&RetentionReport) + Send>,
+    state: CurrentState,
+    pause: Option<Pause>,
+    /// Told of retention, pauses and resumptions (the operator must know).
+    on_notice: Box<dyn Fn(&LogNotice) + Send>,
 }
 
 impl McapSink {
@@ -60,9 +145,12 @@ impl McapSink {
                 rates,
                 next_flush_ns: origin_ns + FLUSH_EVERY_NS,
                 last_ns: origin_ns,
+                flushed_ns: origin_ns,
                 errors: Vec::new(),
                 messages: 0,
-                on_retention: Box::new(|_| {}),
+                state: CurrentState::default(),
+                pause: None,
+                on_notice: Box::new(|_| {}),
             },
             recovered,
         ))
@@ -92,19 +180,19 @@ impl McapSink {
         McapSink::open(logger, config.sample_rates(), origin_ns)
     }
 
-    /// Calls `report` for every retention pass that deleted files: the one at start (now) and
-    /// those after each rotation.
-    pub fn on_retention(mut self, report: impl Fn(&RetentionReport) + Send + 'static) -> Self {
-        if let Some(startup) = self
+    /// Calls `notice` for what the operator must know: the retention pass at start (now, and
+    /// written as a `/log` note in the first file), those after each rotation, and pauses of
+    /// the log for a full disk.
+    pub fn on_notice(mut self, notice: impl Fn(&LogNotice) + Send + 'static) -> Self {
+        let startup = self
             .logger
             .as_mut()
-            .and_then(|l| l.take_startup_retention())
-        {
-            if !startup.deleted.is_empty() {
-                report(&startup);
-            }
+            .and_then(McapLogger::take_startup_retention);
+        self.on_notice = Box::new(notice);
+        if let Some(startup) = startup {
+            let at = self.origin_ns;
+            self.retention_done(startup, at);
         }
-        self.on_retention = Box::new(report);
         self
     }
 
@@ -128,34 +216,190 @@ impl McapSink {
             PipelineMessage::Ingest(_) => self.last_ns,
         }
     }
+
+    /// Says a retention pass that deleted files, in the journal (the notice) and as one `/log`
+    /// note per deleted file in the open file.
+    fn retention_done(&mut self, report: RetentionReport, at_ns: u64) {
+        if report.deleted.is_empty() {
+            return;
+        }
+        if let Some(logger) = self.logger.as_mut() {
+            for path in &report.deleted {
+                let text = format!(
+                    "retention: deleted {} to keep the logs within the disk budget \
+                     (outputs.mcap_disk_budget_mb); {} bytes deleted in this pass, {} bytes of \
+                     logs left",
+                    path.display(),
+                    report.bytes_deleted,
+                    report.total_bytes_after
+                );
+                if let Err(e) = logger.note(LogLevel::Info, &text, at_ns) {
+                    self.errors.push(e);
+                }
+            }
+        }
+        (self.on_notice)(&LogNotice::Retention(report));
+    }
+
+    /// Finishes the open file and opens the next, which begins with the current state.
+    fn rotate(&mut self, at_ns: u64) -> Result<(), McapLogError> {
+        let Some(logger) = self.logger.as_mut() else {
+            return Ok(());
+        };
+        let report = logger.rotate(at_ns)?;
+        logger.write_state(&self.state.snapshot(), at_ns)?;
+        self.retention_done(report, at_ns);
+        Ok(())
+    }
+
+    /// A write to the log failed: the file is given up (left for recovery) and logging
+    /// pauses until there is room again; the pipeline goes on.
+    fn pause(&mut self, error: &McapLogError, at_ns: u64) {
+        let abandoned = self.logger.as_mut().and_then(McapLogger::abandon);
+        let pause = self.pause.get_or_insert(Pause {
+            flushed_until_ns: self.flushed_ns,
+            messages: 0,
+            next_try_ns: at_ns,
+            abandoned: Vec::new(),
+        });
+        pause.next_try_ns = at_ns + RETRY_EVERY_NS;
+        if let Some(path) = abandoned {
+            pause.abandoned.push(path.clone());
+            (self.on_notice)(&LogNotice::Paused {
+                path,
+                error: with_causes(error),
+                flushed_until_ns: pause.flushed_until_ns,
+            });
+        }
+    }
+
+    /// While paused: counts the message, and at most once a second of log time, when the log
+    /// directory has room again, recovers the files left by the failure and opens a new one.
+    /// `true` once logging goes on.
+    fn try_resume(&mut self, at_ns: u64) -> bool {
+        let (Some(pause), Some(logger)) = (self.pause.as_mut(), self.logger.as_mut()) else {
+            return true;
+        };
+        if at_ns < pause.next_try_ns {
+            pause.messages += 1;
+            return false;
+        }
+        pause.next_try_ns = at_ns + RETRY_EVERY_NS;
+        let needed = 2 * logger.config().chunk_size + (1 << 20);
+        if free_bytes(&logger.config().dir).is_some_and(|free| free < needed) {
+            pause.messages += 1;
+            return false;
+        }
+        let notices = recover_abandoned(std::mem::take(&mut pause.abandoned));
+        let opened = logger
+            .reopen(at_ns)
+            .and_then(|()| logger.write_state(&self.state.snapshot(), at_ns))
+            .and_then(|()| logger.flush());
+        for notice in &notices {
+            (self.on_notice)(notice);
+        }
+        if opened.is_err() {
+            // Still no room after all (the free space was taken meanwhile): paused again.
+            if let Some(path) = logger.abandon() {
+                pause.abandoned.push(path);
+            }
+            pause.messages += 1;
+            return false;
+        }
+        let seconds = at_ns.saturating_sub(pause.flushed_until_ns) as f64 / 1e9;
+        let messages = pause.messages;
+        let text = format!(
+            "logging resumed after a write failure (full disk?): {messages} messages of the \
+             pipeline were not logged, {seconds:.1} s of signal from the last flush before the \
+             failure"
+        );
+        let noted = logger.note(LogLevel::Warning, &text, at_ns);
+        let path = logger
+            .current_path()
+            .map(Path::to_path_buf)
+            .unwrap_or_default();
+        self.pause = None;
+        if let Err(e) = noted {
+            self.pause(&e, at_ns);
+            return false;
+        }
+        self.flushed_ns = at_ns;
+        (self.on_notice)(&LogNotice::Resumed {
+            path,
+            messages_not_logged: messages,
+            seconds_not_logged: seconds,
+        });
+        true
+    }
+}
+
+/// An error's message followed by those of its causes that it does not already say (the
+/// `mcap` crate's I/O error hides the OS's reason, e.g. "No space left on device").
+fn with_causes(error: &dyn std::error::Error) -> String {
+    let mut text = error.to_string();
+    let mut cause = error.source();
+    while let Some(inner) = cause {
+        let said = inner.to_string();
+        if !text.contains(&said) {
+            text.push_str(": ");
+            text.push_str(&said);
+        }
+        cause = inner.source();
+    }
+    text
+}
+
+/// Recovers the files a pause left unfinished; what became of each.
+fn recover_abandoned(paths: Vec<PathBuf>) -> Vec<LogNotice> {
+    paths
+        .into_iter()
+        .map(|path| match recover_file(&path) {
+            Ok(report) => LogNotice::PausedFileRecovered(report),
+            Err(e) => LogNotice::PausedFileNotRecovered {
+                path,
+                error: e.to_string(),
+            },
+        })
+        .collect()
+}
+
+/// Free bytes for an unprivileged writer in `dir`'s file system; `None` if it cannot be told.
+fn free_bytes(dir: &Path) -> Option<u64> {
+    use std::os::unix::ffi::OsStrExt;
+    let path = std::ffi::CString::new(dir.as_os_str().as_bytes()).ok()?;
+    let mut stat = std::mem::MaybeUninit::<libc::statvfs>::uninit();
+    // SAFETY: `path` is a NUL-terminated string that outlives the call; `stat` is written by
+    // statvfs before it is read, and only read when the call succeeded.
+    #[allow(unsafe_code)]
+    let stat = unsafe {
+        if libc::statvfs(path.as_ptr(), stat.as_mut_ptr()) != 0 {
+            return None;
+        }
+        stat.assume_init()
+    };
+    // The field types are u32 on some 32-bit targets (arm edge boxes), u64 here.
+    #[allow(clippy::useless_conversion)]
+    let (blocks, size) = (u64::from(stat.f_bavail), u64::from(stat.f_frsize));
+    Some(blocks.saturating_mul(size))
 }
 
 impl Sink for McapSink {
     fn write(&mut self, message: &PipelineMessage) {
         let time = self.log_time(message);
         self.last_ns = self.last_ns.max(time);
-        let Some(logger) = self.logger.as_mut() else {
-            return;
-        };
-        match logger.log(message, time, time) {
-            Ok(retention) => {
-                self.messages += 1;
-                if let Some(report) = retention.filter(|r| !r.deleted.is_empty()) {
-                    (self.on_retention)(&report);
-                }
-            }
-            Err(e) if self.errors.len() < 10 => self.errors.push(e),
-            Err(_) => {}
+        let resumed = self.pause.is_none() || self.try_resume(self.last_ns);
+        if resumed {
+            self.log(message, time);
         }
-        if self.last_ns >= self.next_flush_ns {
-            self.next_flush_ns = self.last_ns + FLUSH_EVERY_NS;
-            if let Err(e) = logger.flush() {
-                self.errors.push(e);
-            }
-        }
+        self.state.note(message);
     }
 
     fn finish(&mut self) -> Result<(), SinkError> {
+        if let Some(pause) = self.pause.take() {
+            for notice in recover_abandoned(pause.abandoned) {
+                (self.on_notice)(&notice);
+            }
+        }
         let finished = self.logger.take().map(|l| l.finish());
         if let Some(Err(e)) = finished {
             self.errors.push(e);
@@ -169,6 +413,48 @@ impl Sink for McapSink {
                 count,
                 first: Box::new(first),
             }),
+        }
+    }
+}
+
+impl McapSink {
+    /// Logs one message: rotates first when due (the next file begins with the current
+    /// state), never writes a log time before the open file's start (a twin fit finished after
+    /// a rotation over a window before it keeps that window's time as its `publish_time`), and
+    /// flushes every second of data. A write that fails pauses the log.
+    fn log(&mut self, message: &PipelineMessage, time: u64) {
+        let due = self
+            .logger
+            .as_ref()
+            .is_some_and(|logger| logger.needs_rotation(time));
+        if due {
+            if let Err(e) = self.rotate(time) {
+                self.pause(&e, time);
+                return;
+            }
+        }
+        let Some(logger) = self.logger.as_mut() else {
+            return;
+        };
+        let log_time = time.max(logger.current_file_start().unwrap_or(0));
+        // A rotation inside `log` cannot happen (it was checked just above at the same time);
+        // were there one, its retention is still said.
+        match logger.log(message, log_time, time) {
+            Ok(rotated) => {
+                self.messages += 1;
+                if let Some(report) = rotated {
+                    self.retention_done(report, log_time);
+                }
+            }
+            Err(e) => return self.pause(&e, time),
+        }
+        if self.last_ns >= self.next_flush_ns {
+            self.next_flush_ns = self.last_ns + FLUSH_EVERY_NS;
+            let flushed = self.logger.as_mut().map_or(Ok(()), McapLogger::flush);
+            match flushed {
+                Ok(()) => self.flushed_ns = self.last_ns,
+                Err(e) => self.pause(&e, time),
+            }
         }
     }
 }

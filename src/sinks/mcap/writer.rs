@@ -131,10 +131,15 @@ pub struct RetentionReport {
 /// Tracks the logical position and length of a seekable stream, so the open file's size is
 /// known without a syscall per message. `mcap::Writer` does not lend out its stream, so the
 /// length is shared through an atomic (the logger may move between threads).
+///
+/// After the first failed write (a full disk) it refuses every later write, so that the file
+/// stays a prefix of what the writer produced (what recovery reads) and the `mcap` writer's
+/// drop, which tries to finish the file, adds nothing after a hole.
 struct Counting<W> {
     inner: W,
     pos: u64,
     len: Arc<AtomicU64>,
+    failed: bool,
 }
 
 impl<W> Counting<W> {
@@ -145,19 +150,28 @@ impl<W> Counting<W> {
 
 impl<W: Write> Write for Counting<W> {
     fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        let n = self.inner.write(buf)?;
+        if self.failed {
+            return Err(io::Error::other("an earlier write to this file failed"));
+        }
+        let n = self.inner.write(buf).inspect_err(|_| self.failed = true)?;
         self.pos += n as u64;
         self.note();
         Ok(n)
     }
     fn flush(&mut self) -> io::Result<()> {
-        self.inner.flush()
+        if self.failed {
+            return Err(io::Error::other("an earlier write to this file failed"));
+        }
+        self.inner.flush().inspect_err(|_| self.failed = true)
     }
 }
 
 impl<W: Seek> Seek for Counting<W> {
     fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
-        self.pos = self.inner.seek(pos)?;
+        if self.failed {
+            return Err(io::Error::other("an earlier write to this file failed"));
+        }
+        self.pos = self.inner.seek(pos).inspect_err(|_| self.failed = true)?;
         self.note();
         Ok(self.pos)
     }
@@ -174,6 +188,15 @@ struct OpenFile {
     channels: HashMap<String, (u16, u32)>,
     raw_schema: Option<u16>,
     json_schemas: HashMap<JsonKind, u16>,
+    /// `/log` and `/state`: (channel id, next sequence), on first use.
+    side_channels: HashMap<Side, (u16, u32)>,
+}
+
+/// The channels beside the pipeline's topics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+enum Side {
+    Log,
+    State,
 }
 
 impl OpenFile {
@@ -204,6 +227,7 @@ impl OpenFile {
             inner: BufWriter::with_capacity(256 * 1024, file),
             pos: 0,
             len: Arc::clone(&len),
+            failed: false,
         };
         let werr = |source| McapLogError::Write {
             path: path.clone(),
@@ -238,7 +262,64 @@ impl OpenFile {
             channels: HashMap::new(),
             raw_schema: None,
             json_schemas: HashMap::new(),
+            side_channels: HashMap::new(),
         })
+    }
+
+    /// A channel beside the pipeline's (`/log`, `/state`), registered with its JSON schema on
+    /// first use.
+    fn side_channel(&mut self, side: Side) -> Result<&mut (u16, u32)> {
+        if !self.side_channels.contains_key(&side) {
+            let werr = |source| McapLogError::Write {
+                path: self.path.clone(),
+                source,
+            };
+            let (topic, name, schema) = match side {
+                Side::Log => (
+                    schema::LOG_TOPIC,
+                    schema::LOG_SCHEMA,
+                    schema::log_json_schema(),
+                ),
+                Side::State => (
+                    schema::STATE_TOPIC,
+                    schema::STATE_SCHEMA,
+                    schema::StateSnapshot::json_schema(),
+                ),
+            };
+            let data = schema.to_string();
+            let schema_id = self
+                .writer
+                .add_schema(name, "jsonschema", data.as_bytes())
+                .map_err(werr)?;
+            let id = self
+                .writer
+                .add_channel(schema_id, topic, "json", &BTreeMap::new())
+                .map_err(werr)?;
+            self.side_channels.insert(side, (id, 0));
+        }
+        self.side_channels
+            .get_mut(&side)
+            .ok_or_else(|| McapLogError::Config("a side channel vanished".into()))
+    }
+
+    /// Writes `payload` on a side channel at `log_time_ns`.
+    fn write_side(&mut self, side: Side, payload: &[u8], log_time_ns: u64) -> Result<()> {
+        let entry = self.side_channel(side)?;
+        let header = MessageHeader {
+            channel_id: entry.0,
+            sequence: entry.1,
+            log_time: log_time_ns,
+            publish_time: log_time_ns,
+        };
+        entry.1 = entry.1.wrapping_add(1);
+        self.writer
+            .write_to_known_channel(&header, payload)
+            .map_err(|source| McapLogError::Write {
+                path: self.path.clone(),
+                source,
+            })?;
+        self.first_log_time.get_or_insert(log_time_ns);
+        Ok(())
     }
 
     /// Writes the summary, flushes and fsyncs; returns the final size.
@@ -322,6 +403,8 @@ pub struct McapLogger {
     payload: Vec<u8>,
     /// What the retention pass at creation deleted, until the owner takes it.
     startup_retention: Option<RetentionReport>,
+    /// A file whose finishing failed in a rotation (a full disk), until [`Self::abandon`].
+    unfinished: Option<PathBuf>,
 }
 
 impl McapLogger {
@@ -341,6 +424,7 @@ impl McapLogger {
             topic: String::with_capacity(64),
             payload: Vec::with_capacity(64 * 1024),
             startup_retention: None,
+            unfinished: None,
         };
         logger.open_file(opened_at_ns)?;
         logger.startup_retention = Some(logger.apply_retention()?);
@@ -381,6 +465,75 @@ impl McapLogger {
 
     pub fn config(&self) -> &LoggerConfig {
         &self.config
+    }
+
+    /// Whether a message logged at `log_time_ns` would rotate the open file first (it is full
+    /// or spans `max_file_duration_ns`), so that a caller can rotate itself and begin the next
+    /// file with what it must start with.
+    pub fn needs_rotation(&self, log_time_ns: u64) -> bool {
+        self.open.as_ref().is_some_and(|f| {
+            f.bytes() >= self.config.max_file_bytes
+                || f.first_log_time.is_some_and(|t0| {
+                    log_time_ns.saturating_sub(t0) >= self.config.max_file_duration_ns
+                })
+        })
+    }
+
+    /// Log time of the open file's first message (its start), if it has one.
+    pub fn current_file_start(&self) -> Option<u64> {
+        self.open.as_ref().and_then(|f| f.first_log_time)
+    }
+
+    /// Writes an operator note on the `/log` topic (Foxglove's `foxglove.Log`, JSON) of the
+    /// open file: what the daemon did to the logs (retention, a pause for a full disk), kept
+    /// in the log itself and not only in the journal.
+    pub fn note(&mut self, level: schema::LogLevel, text: &str, log_time_ns: u64) -> Result<()> {
+        let payload = schema::log_note(level, text, log_time_ns);
+        self.open_mut()?
+            .write_side(Side::Log, &payload, log_time_ns)
+    }
+
+    /// Writes the state snapshot on `/state` ([`schema::StateSnapshot`]) of the open file.
+    pub fn write_state(
+        &mut self,
+        snapshot: &schema::StateSnapshot,
+        log_time_ns: u64,
+    ) -> Result<()> {
+        let payload = serde_json::to_vec(snapshot)
+            .map_err(|e| McapLogError::Config(format!("state snapshot: {e}")))?;
+        self.open_mut()?
+            .write_side(Side::State, &payload, log_time_ns)
+    }
+
+    fn open_mut(&mut self) -> Result<&mut OpenFile> {
+        self.open
+            .as_mut()
+            .ok_or_else(|| McapLogError::Config("no open file".into()))
+    }
+
+    /// Gives up the open file after a write failed (a full disk): nothing more is written to
+    /// it, it is left unfinished (a prefix of what was written, which
+    /// [`super::recover_file`] makes whole) and its path returned. [`Self::log`] then opens
+    /// the next file; [`Self::reopen`] does so explicitly.
+    pub fn abandon(&mut self) -> Option<PathBuf> {
+        if let Some(path) = self.unfinished.take() {
+            return Some(path);
+        }
+        self.open.take().map(|file| {
+            let path = file.path.clone();
+            // Its stream refuses writes after the failure, so the writer's drop (which tries
+            // to finish the file) writes nothing.
+            drop(file);
+            path
+        })
+    }
+
+    /// Opens a new file named after `opened_at_ns` if none is open (after [`Self::abandon`]).
+    pub fn reopen(&mut self, opened_at_ns: u64) -> Result<()> {
+        if self.open.is_none() {
+            self.open_file(opened_at_ns)?;
+        }
+        Ok(())
     }
 
     /// Logs one pipeline message on its topic. `log_time_ns`/`publish_time_ns` are wall time in
@@ -465,7 +618,10 @@ impl McapLogger {
     /// budget.
     pub fn rotate(&mut self, opened_at_ns: u64) -> Result<RetentionReport> {
         if let Some(file) = self.open.take() {
-            let bytes = file.finish()?;
+            let path = file.path.clone();
+            let bytes = file
+                .finish()
+                .inspect_err(|_| self.unfinished = Some(path))?;
             self.stats.files_finished += 1;
             self.stats.finished_file_bytes += bytes;
         }
