@@ -14,4 +14,5 @@ mod monitor;
 mod physics;
 mod severity;
 mod speed;
+mod trend;
 mod twin;
