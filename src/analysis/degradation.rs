@@ -73,7 +73,7 @@ impl TrendFit {
         let mean_t = times.iter().sum::<f64>() / nf;
         let mean_y = logs.iter().sum::<f64>() / nf;
         let sxx: f64 = times.iter().map(|t| (t - mean_t).powi(2)).sum();
-        if !(sxx > 0.0) {
+        if sxx <= 0.0 || sxx.is_nan() {
             return None;
         }
         let sxy: f64 = times
@@ -142,7 +142,7 @@ impl TrendFit {
             return Some(self.now_s);
         }
         let ahead = self.horizon_s - self.now_s;
-        if !(ahead > 0.0) {
+        if ahead <= 0.0 || ahead.is_nan() {
             return None;
         }
         const STEPS: usize = 256;
@@ -244,7 +244,7 @@ mod tests {
     }
 
     /// `y = 0.3·exp(t/1000)` reaches 1.2 at `t = 1000·ln 4 = 1386.29 s`.
-    const TRUE_CROSSING: f64 = 1386.294_361;
+    const TRUE_CROSSING: f64 = 1_386.294_361;
 
     #[test]
     fn an_exact_exponential_crosses_where_it_should() {

@@ -330,7 +330,9 @@ pub fn hindsight(points: &[LifePoint]) -> Option<TrendHindsight> {
         i + confirm <= points.len() && points[i..i + confirm].iter().all(|p| p.rms > threshold)
     })?;
     let crossed_s = points[crossed_at].time_s;
-    let before: Vec<(f64, Option<f64>, Option<(f64, f64)>)> = points[..crossed_at]
+    // (made at, predicted crossing, band) of each estimate before the crossing.
+    type Estimate = (f64, Option<f64>, Option<(f64, f64)>);
+    let before: Vec<Estimate> = points[..crossed_at]
         .iter()
         .filter_map(|p| {
             let t = p.trend.filter(|t| t.threshold == threshold)?;

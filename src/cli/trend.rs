@@ -78,9 +78,21 @@ struct Placed {
     seconds: f64,
 }
 
+/// What a directory holds: snapshots in time order, files that could not be placed, files
+/// that are not snapshots.
+struct Listing {
+    placed: Vec<Placed>,
+    skipped: Vec<SkippedFile>,
+    ignored: Vec<String>,
+}
+
 pub fn run(args: &TrendArgs) -> Result<(), CliError> {
     let settings = settings_from(args)?;
-    let (placed, mut skipped, ignored) = list_snapshots(args)?;
+    let Listing {
+        placed,
+        mut skipped,
+        ignored,
+    } = list_snapshots(args)?;
     let first_s = placed.first().map_or(0.0, |p| p.seconds);
     let mut life = LifeTracker::new(settings.clone());
     let mut points = Vec::new();
@@ -285,9 +297,7 @@ fn settings_from(args: &TrendArgs) -> Result<LifeSettings, CliError> {
 
 /// The snapshots under `args.path` in time order, the files that could not be placed, and the
 /// files that are not snapshots at all.
-fn list_snapshots(
-    args: &TrendArgs,
-) -> Result<(Vec<Placed>, Vec<SkippedFile>, Vec<String>), CliError> {
+fn list_snapshots(args: &TrendArgs) -> Result<Listing, CliError> {
     let path = &args.path;
     let files: Vec<PathBuf> = if path.is_dir() {
         let entries = std::fs::read_dir(path).map_err(|e| {
@@ -352,7 +362,11 @@ fn list_snapshots(
         })),
     }
     placed.sort_by(|a, b| a.seconds.total_cmp(&b.seconds).then(a.path.cmp(&b.path)));
-    Ok((placed, skipped, ignored))
+    Ok(Listing {
+        placed,
+        skipped,
+        ignored,
+    })
 }
 
 fn is_mcap(path: &Path) -> bool {
