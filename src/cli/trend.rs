@@ -128,15 +128,12 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         };
         let (fs_hz, freqs) = match resolve_conditions(&recording, &request, false) {
             Ok(c) => {
-                notes.extend(
-                    c.warnings
-                        .iter()
-                        .filter(|w| !w.contains("last row"))
-                        .cloned(),
-                );
+                // The recording's own warnings are among them.
+                notes.extend(c.warnings);
                 (c.fs_hz, Some(c.bearing.fault_frequencies(c.rpm / 60.0)))
             }
             Err(OfflineError::UnknownSpeed { .. } | OfflineError::UnknownBearing { .. }) => {
+                notes.extend(recording.warnings.iter().cloned());
                 notes.insert("no shaft speed or bearing known for some snapshots: no envelope fault score for them; give --rpm (and --bearing) to score the fault bands".into());
                 match args.recording.fs.or(recording.fs_hz) {
                     Some(fs) => (fs, None),
@@ -158,9 +155,6 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
                 continue;
             }
         };
-        for w in &recording.warnings {
-            notes.insert(w.clone());
-        }
         channel.get_or_insert_with(|| recording.channel.clone());
         let window = ((args.window * fs_hz).round() as usize).max(1);
         let pieces: Vec<&[f64]> = if recording.samples.len() * 2 > window * 3 {
@@ -383,13 +377,13 @@ fn file_label(path: &Path) -> String {
 
 fn table(report: &LifeReport) -> String {
     let mut out = String::from(
-        "| snapshot | time (h) | life % | RMS (g) | kurtosis | HW residual % | fault score | stage |\n|---|---|---|---|---|---|---|---|\n",
+        "| snapshot | time (s) | life % | RMS (g) | kurtosis | HW residual % | fault score | stage |\n|---|---|---|---|---|---|---|---|\n",
     );
     for p in &report.points {
         out.push_str(&format!(
-            "| {} | {:.3} | {:.1} | {:.3} | {:.2} | {} | {} | {} |\n",
+            "| {} | {:.1} | {:.1} | {:.3} | {:.2} | {} | {} | {} |\n",
             p.source,
-            p.time_s / 3600.0,
+            p.time_s,
             100.0 * report.life_fraction(p.time_s),
             p.rms,
             p.kurtosis,

@@ -181,3 +181,44 @@ fn unreadable_snapshots_are_skipped_counted_and_named() {
     );
     assert!(!err.contains("panicked"), "{err}");
 }
+
+#[test]
+fn a_bearingd_log_is_cut_into_windows_in_sample_time() {
+    let Some(ims) = shared_data_dir("ims") else {
+        return;
+    };
+    let dir = scratch_dir("trend-log");
+    let out = bearingd(&[
+        "import",
+        ims.join("2003.10.22.12.14.13").to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let log = bearingd_testdata::mcap_files(&dir)
+        .pop()
+        .expect("import wrote a log");
+    // 20,480 samples at 20 kHz in windows of 0.25 s: 4 snapshots, 0.25 s apart.
+    let report = trend_json(
+        &log,
+        &[
+            "--window",
+            "0.25",
+            "--baseline",
+            "2",
+            "--no-hw",
+            "--rpm",
+            "2000",
+            "--bearing",
+            "rexnord-za-2115",
+        ],
+    );
+    let points = report["points"].as_array().unwrap();
+    let times: Vec<f64> = points
+        .iter()
+        .map(|p| p["time_s"].as_f64().unwrap())
+        .collect();
+    assert_eq!(times, [0.0, 0.25, 0.5, 0.75], "{report}");
+    assert!(points[3]["source"].as_str().unwrap().ends_with(".mcap#3"));
+    assert!(points.iter().all(|p| p["fault_score"].is_number()));
+}
