@@ -11,6 +11,10 @@
 use crate::messages::HealthStage;
 use serde::{Deserialize, Serialize};
 
+/// Consecutive windows beyond a limit that confirm a change of stage (the daemon's and
+/// `bearingd trend`'s).
+pub const CONFIRM_WINDOWS: u32 = 3;
+
 /// Mean and standard deviation of a statistic over a number of windows (Welford).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct RunningStats {

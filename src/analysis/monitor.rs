@@ -40,7 +40,7 @@ use super::diagnosis::{leader, Contest, Named};
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::{FaultFlag, FlagChange, FlagSettings};
-use super::health::{Baseline, HealthTracker, StageChange};
+use super::health::{Baseline, HealthTracker, StageChange, CONFIRM_WINDOWS};
 use super::indicators::Indicators;
 use super::record::envelope_range_hz;
 use super::speed::SpeedSearch;
@@ -252,7 +252,12 @@ impl ChannelMonitor {
             ),
             scorer,
             flags: std::array::from_fn(|_| FaultFlag::new(settings.flags)),
-            health: HealthTracker::new(settings.baseline_windows, settings.sigma, 3, baseline),
+            health: HealthTracker::new(
+                settings.baseline_windows,
+                settings.sigma,
+                CONFIRM_WINDOWS,
+                baseline,
+            ),
             scores,
             explained: scores,
             bands: [whole; 4],

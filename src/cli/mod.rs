@@ -18,6 +18,7 @@ mod ingest;
 mod replay;
 mod run;
 mod simulate;
+mod trend;
 
 use clap::{Args, Parser, Subcommand};
 use std::process::ExitCode;
@@ -101,6 +102,10 @@ enum Command {
     /// Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records)
     /// through the real pipeline: detection probability, false alarms, confusion matrix, plot.
     Evaluate(evaluate::EvaluateArgs),
+    /// Follow a bearing's life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs):
+    /// health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its
+    /// time to the failure limit; text, JSON or a table, and a plot.
+    Trend(trend::TrendArgs),
     /// Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV.
     Simulate(simulate::SimulateArgs),
     /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
@@ -135,6 +140,7 @@ pub fn main() -> ExitCode {
         Command::Replay(args) => replay::run(&args),
         Command::Import(args) => import::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Trend(args) => trend::run(&args),
         Command::Evaluate(args) => evaluate::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Validate { file } => config_cmd::validate(&file),

@@ -20,8 +20,11 @@ mod ims;
 mod mat;
 mod mat5;
 mod mcap;
+mod snapshot_time;
 mod text;
 mod wav;
+
+pub use snapshot_time::{time_from_name, NamedTime, NamedTimeKind, PRONOSTIA_PERIOD_S};
 
 use std::fmt;
 use std::path::{Path, PathBuf};

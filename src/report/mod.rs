@@ -3,9 +3,13 @@
 //! always say the same thing.
 
 mod figure;
+mod life;
 mod text;
 
 pub use figure::analysis_figure;
+pub use life::{
+    duration_text, life_figure, render_life_text, LifeReport, LifeSettingsReport, SkippedFile,
+};
 pub use text::render_text;
 
 use crate::analysis::fault_bands::HarmonicPeak;

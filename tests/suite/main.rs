@@ -15,4 +15,5 @@ mod physics;
 mod replay;
 mod severity;
 mod speed;
+mod trend;
 mod twin;
