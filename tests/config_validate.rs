@@ -95,6 +95,7 @@ fn defaults_in_code_agree_with_the_default_file() {
     assert_eq!(from_code.twin, from_file.twin);
     assert_eq!(from_code.thresholds, from_file.thresholds);
     assert_eq!(from_code.outputs, from_file.outputs);
+    assert_eq!(from_code.severity, from_file.severity);
     // The file's sensor writes out every default too.
     assert_eq!(from_code.sensors, from_file.sensors);
 }
