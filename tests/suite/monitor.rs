@@ -419,7 +419,7 @@ fn the_velocity_zone_flag_rises_and_falls_with_the_fault_flags_hysteresis() {
     let first_in_c = readings.iter().find(|r| r.rms_mm_s >= 2.8).unwrap();
     let raise = readings
         .iter()
-        .find(|r| r.end_sample - first_in_c.end_sample >= on_delay)
+        .find(|r| r.end_sample >= first_in_c.end_sample + on_delay)
         .unwrap();
     let first_clear = readings
         .iter()
@@ -427,10 +427,7 @@ fn the_velocity_zone_flag_rises_and_falls_with_the_fault_flags_hysteresis() {
         .unwrap();
     let fall = readings
         .iter()
-        .find(|r| {
-            r.end_sample - first_clear.end_sample >= off_delay
-                && r.end_sample > first_clear.end_sample
-        })
+        .find(|r| r.end_sample >= first_clear.end_sample + off_delay)
         .unwrap();
     let got: Vec<_> = changes
         .iter()
