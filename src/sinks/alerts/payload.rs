@@ -252,37 +252,28 @@ impl Alert {
 impl AlertView {
     /// One line for people: what, where, how sure, and where in the signal.
     pub fn line(&self) -> String {
-        if self.fault == crate::messages::VELOCITY_FLAG_NAME {
-            return format!(
-                "#{} {}/{} {} {} ({} → {}): ISO velocity {:.2} mm/s, t = {:.1} s",
-                self.sequence,
-                self.sensor,
-                self.axis,
-                self.fault,
-                self.state.name(),
-                self.previous_severity,
-                self.severity,
-                self.score,
-                self.sample_time_s
-            );
-        }
-        let twin = self.twin_error.map_or("no twin fit yet".to_string(), |e| {
-            format!("twin error {e:.3}")
-        });
-        format!(
-            "#{} {}/{} {} {} ({} → {}): score {:.1} at {:.1} Hz, confidence {:.2}, {}, t = {:.1} s",
+        let head = format!(
+            "#{} {}/{} {} {} ({} → {})",
             self.sequence,
             self.sensor,
             self.axis,
             self.fault,
             self.state.name(),
             self.previous_severity,
-            self.severity,
-            self.score,
-            self.fault_frequency_hz,
-            self.confidence,
-            twin,
-            self.sample_time_s
+            self.severity
+        );
+        if self.fault == crate::messages::VELOCITY_FLAG_NAME {
+            return format!(
+                "{head}: ISO velocity {:.2} mm/s, t = {:.1} s",
+                self.score, self.sample_time_s
+            );
+        }
+        let twin = self.twin_error.map_or("no twin fit yet".to_string(), |e| {
+            format!("twin error {e:.3}")
+        });
+        format!(
+            "{head}: score {:.1} at {:.1} Hz, confidence {:.2}, {}, t = {:.1} s",
+            self.score, self.fault_frequency_hz, self.confidence, twin, self.sample_time_s
         )
     }
 }

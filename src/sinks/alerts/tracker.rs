@@ -143,7 +143,6 @@ impl AlertTracker {
 
     fn alert_for(&self, flag: &FlagMessage, wall_time_ns: u64) -> Option<(AlertKey, Alert)> {
         let (fault, from, to) = (flag.fault, flag.from, flag.to);
-        let state = AlertState::of_change(from, to);
         let index = fault.index();
         let runner_up = self.scores.get(&flag.channel).map_or(1.0, |scores| {
             scores
@@ -160,61 +159,68 @@ impl AlertTracker {
                 confidence = twin_adjusted_confidence(confidence, best == fault, twin.margin);
             }
         }
-        let key = (flag.channel.clone(), fault_code(fault));
-        Some((
-            key,
-            Alert {
-                sequence: 0,
-                run_id: self.run_id,
-                end_sample: flag.end_sample,
+        let alert = Alert {
+            fault_frequency_hz: flag.fault_frequency_hz,
+            score: flag.score,
+            confidence,
+            twin_error: twin.map_or(f64::NAN, |t| t.errors[index]),
+            ..self.change_alert(
+                &flag.channel,
+                flag.end_sample,
                 wall_time_ns,
-                sample_rate_hz: self
-                    .rates
-                    .get(&flag.channel.sensor)
-                    .copied()
-                    .unwrap_or(f64::NAN),
-                fault_frequency_hz: flag.fault_frequency_hz,
-                score: flag.score,
-                confidence,
-                twin_error: twin.map_or(f64::NAN, |t| t.errors[index]),
-                version: ALERT_VERSION,
-                state: state as u8,
-                fault: fault_code(fault),
-                severity: severity_code(to),
-                previous_severity: severity_code(from),
-                sensor: name_field(&flag.channel.sensor),
-                axis: name_field(&flag.channel.axis),
-            },
-        ))
+                fault_code(fault),
+                (from, to),
+            )
+        };
+        Some(((flag.channel.clone(), fault_code(fault)), alert))
     }
 
     /// The alert of a velocity zone flag: a measurement against the standard's boundary, not
     /// a hypothesis, so its confidence is 1.
     fn zone_alert_for(&self, flag: &VelocityFlagMessage, wall_time_ns: u64) -> (AlertKey, Alert) {
-        let key = (flag.channel.clone(), ISO_ZONE_CODE);
         let alert = Alert {
-            sequence: 0,
-            run_id: self.run_id,
-            end_sample: flag.end_sample,
-            wall_time_ns,
-            sample_rate_hz: self
-                .rates
-                .get(&flag.channel.sensor)
-                .copied()
-                .unwrap_or(f64::NAN),
-            fault_frequency_hz: f64::NAN,
             score: flag.rms_mm_s,
             confidence: 1.0,
+            ..self.change_alert(
+                &flag.channel,
+                flag.end_sample,
+                wall_time_ns,
+                ISO_ZONE_CODE,
+                (flag.from, flag.to),
+            )
+        };
+        ((flag.channel.clone(), ISO_ZONE_CODE), alert)
+    }
+
+    /// What every alert of a flag change (`from`, `to`) says: where, when, which flag (`code`,
+    /// see [`Alert::fault`]) and its state; its evidence (frequency, score, confidence, twin)
+    /// NaN, for the caller to set.
+    fn change_alert(
+        &self,
+        channel: &ChannelId,
+        end_sample: u64,
+        wall_time_ns: u64,
+        code: u8,
+        (from, to): (FlagLevel, FlagLevel),
+    ) -> Alert {
+        Alert {
+            sequence: 0,
+            run_id: self.run_id,
+            end_sample,
+            wall_time_ns,
+            sample_rate_hz: self.rates.get(&channel.sensor).copied().unwrap_or(f64::NAN),
+            fault_frequency_hz: f64::NAN,
+            score: f64::NAN,
+            confidence: f64::NAN,
             twin_error: f64::NAN,
             version: ALERT_VERSION,
-            state: AlertState::of_change(flag.from, flag.to) as u8,
-            fault: ISO_ZONE_CODE,
-            severity: severity_code(flag.to),
-            previous_severity: severity_code(flag.from),
-            sensor: name_field(&flag.channel.sensor),
-            axis: name_field(&flag.channel.axis),
-        };
-        (key, alert)
+            state: AlertState::of_change(from, to) as u8,
+            fault: code,
+            severity: severity_code(to),
+            previous_severity: severity_code(from),
+            sensor: name_field(&channel.sensor),
+            axis: name_field(&channel.axis),
+        }
     }
 
     fn emit(&mut self, key: AlertKey, mut alert: Alert, publish: &mut impl FnMut(Alert)) {
