@@ -1,12 +1,14 @@
 //! Speed of the analysis core (issue 2 targets, reported in docs/PERFORMANCE.md):
 //! - `analyze` of a 10 s, 12 kHz record: ≤ 10 ms on one core;
-//! - one rolling envelope-spectrum update with a 16384-sample window: ≤ 150 µs.
+//! - one rolling envelope-spectrum update with a 16384-sample window: ≤ 150 µs;
+//! - (issue 16) the ISO velocity severity, per record and per daemon reading.
 //!
 //! Run: `cargo bench --bench analysis`. The record is CWRU 105 when ../shared/data is there,
 //! else 10 s of the twin's simulated outer-race fault (the same size).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::envelope::{FftPlans, RollingEnvelope};
+use bearingd::analysis::iso::{record_severity, SeveritySettings, VelocityTracker};
 use bearingd::analysis::record::{analyze_record, RecordAnalyzer};
 use bearingd::analysis::{AnalysisSettings, Band, BandSelection};
 use bearingd::bearing::BearingGeometry;
@@ -177,5 +179,62 @@ fn twin_refit(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, analyze, rolling_update, twin_refit);
+/// Issue 16 item 4: what the ISO 10816-3 velocity costs. `bearingd analyze` measures it once per
+/// record beside the envelope analysis (the same plans); the daemon once per half velocity
+/// window per channel.
+fn iso_velocity(c: &mut Criterion) {
+    let (signal, fs, rpm, name) = ten_second_record();
+    let freqs = BearingGeometry::from_catalog("skf-6205-2rs")
+        .unwrap()
+        .fault_frequencies(rpm / 60.0);
+    let severity = SeveritySettings::default();
+    let mut group = c.benchmark_group(format!("ISO velocity, 10 s at 12 kHz ({name})"));
+    let mut analyzer = RecordAnalyzer::default();
+    group.bench_function("velocity severity of the record, plans reused", |b| {
+        b.iter(|| {
+            record_severity(&mut analyzer.plans, black_box(&signal), fs, rpm, severity).unwrap()
+        })
+    });
+    let settings = AnalysisSettings::default();
+    group.bench_function("analyze (gk) + velocity severity, plans reused", |b| {
+        b.iter(|| {
+            let analysis = analyzer
+                .analyze(black_box(&signal), fs, &freqs, &settings)
+                .unwrap();
+            let velocity =
+                record_severity(&mut analyzer.plans, black_box(&signal), fs, rpm, severity);
+            (analysis, velocity)
+        })
+    });
+    group.finish();
+
+    // The daemon's rolling tracker at 25.6 kHz: 32,768-sample windows, a reading every 16,384
+    // samples; one iteration pushes one hop (one reading).
+    let fs = 25_600.0;
+    let params = SimulationParams {
+        fs_hz: fs,
+        ..SimulationParams::example(SimulatedFault::OuterRace)
+    };
+    let signal = Simulator::record(params, 8.0);
+    let mut tracker = VelocityTracker::new(fs, 1772.0, severity, 8, &mut FftPlans::default());
+    let hop = tracker.window() / 2;
+    tracker.push(&signal[..tracker.window()], |_| {});
+    let mut at = 0;
+    c.bench_function(
+        "velocity tracker, one reading (hop 16384 samples of a 32768 window at 25.6 kHz, 8 averages)",
+        |b| {
+            b.iter(|| {
+                if at + hop > signal.len() {
+                    at = 0;
+                }
+                let mut rms = 0.0;
+                tracker.push(black_box(&signal[at..at + hop]), |r| rms = r.rms_mm_s);
+                at += hop;
+                black_box(rms)
+            })
+        },
+    );
+}
+
+criterion_group!(benches, analyze, rolling_update, iso_velocity, twin_refit);
 criterion_main!(benches);

@@ -213,7 +213,49 @@ impl SpeedSource {
     }
 }
 
-display_as_name!(FaultKind, FlagLevel, HealthStage, HealthKind, SpeedSource);
+/// An evaluation zone of ISO 10816-3 / 20816-3 for the machine's velocity RMS: A newly
+/// commissioned, B unrestricted long-term operation, C limited operation (plan a repair), D
+/// damage likely. The wire name is the letter (`"A"` … `"D"`).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
+pub enum IsoZone {
+    A,
+    B,
+    C,
+    D,
+}
+
+impl IsoZone {
+    /// The wire name: `A`, `B`, `C`, `D`.
+    pub fn name(self) -> &'static str {
+        match self {
+            IsoZone::A => "A",
+            IsoZone::B => "B",
+            IsoZone::C => "C",
+            IsoZone::D => "D",
+        }
+    }
+
+    /// What the standard says the zone means, in a few words.
+    pub fn meaning(self) -> &'static str {
+        match self {
+            IsoZone::A => "newly commissioned",
+            IsoZone::B => "unrestricted long-term operation",
+            IsoZone::C => "not for long-term operation: plan a repair",
+            IsoZone::D => "severe enough to cause damage",
+        }
+    }
+}
+
+display_as_name!(
+    FaultKind,
+    FlagLevel,
+    HealthStage,
+    HealthKind,
+    SpeedSource,
+    IsoZone
+);
 
 /// Identifies one analysed signal: a sensor (node) and one of its axes.
 #[derive(
@@ -321,6 +363,44 @@ pub struct HealthMessage {
     pub detail: String,
 }
 
+/// How status lines, the command line and alerts name the velocity zone flag (beside the
+/// fault kinds' names).
+pub const VELOCITY_FLAG_NAME: &str = "iso_zone";
+
+/// The ISO 10816-3 / 20816-3 velocity severity of the last few windows (every half window of
+/// the velocity analysis: 0.64 s at 25.6 kHz). Topic `/velocity/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct VelocityMessage {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    /// Velocity RMS in the band, mm/s, integrated from the acceleration and averaged over
+    /// `windows_averaged` windows.
+    pub rms_mm_s: f64,
+    /// The zone of `rms_mm_s` for the configured machine group and foundation.
+    pub zone: IsoZone,
+    /// The standard's band, Hz: [10, 1000], or [2, 1000] below 600 rpm.
+    pub band_hz: [f64; 2],
+    pub windows_averaged: usize,
+    /// The zone flag's level after this reading (`watch` from zone C, `alarm` from zone D, with
+    /// the fault flags' hysteresis and delays).
+    pub flag: FlagLevel,
+}
+
+/// The velocity zone flag changed state. Topic `/velocity_flags/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct VelocityFlagMessage {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    pub from: FlagLevel,
+    pub to: FlagLevel,
+    /// Velocity RMS, mm/s, and its zone, of the reading that changed the flag.
+    pub rms_mm_s: f64,
+    pub zone: IsoZone,
+    /// The zone boundaries the flag is judged against, mm/s: B/C (watch) and C/D (alarm).
+    pub watch_mm_s: f64,
+    pub alarm_mm_s: f64,
+}
+
 /// The shaft speed a channel uses from `end_sample` on (every speed frame, every estimate).
 /// Topic `/speed/<sensor>/<axis>`. A replay feeds the measured ones (`source = "can"`) back at
 /// their samples, so its flags equal the live run's.
@@ -373,4 +453,6 @@ pub enum PipelineMessage {
     Health(HealthMessage),
     Ingest(IngestMessage),
     Speed(SpeedMessage),
+    Velocity(VelocityMessage),
+    VelocityFlag(VelocityFlagMessage),
 }

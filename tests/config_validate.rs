@@ -95,6 +95,7 @@ fn defaults_in_code_agree_with_the_default_file() {
     assert_eq!(from_code.twin, from_file.twin);
     assert_eq!(from_code.thresholds, from_file.thresholds);
     assert_eq!(from_code.outputs, from_file.outputs);
+    assert_eq!(from_code.severity, from_file.severity);
     // The file's sensor writes out every default too.
     assert_eq!(from_code.sensors, from_file.sensors);
 }
@@ -181,7 +182,7 @@ fn unknown_keys_are_named_with_their_line_and_the_known_keys() {
     assert!(
         fault
             .message
-            .contains("known keys here: fault, onset_s, severity, noise_g, seed"),
+            .contains("known keys here: fault, onset_s, severity, noise_g, imbalance_g, seed"),
         "{fault}"
     );
     assert!(fault.message.contains("rename it to `fault`"), "{fault}");
@@ -683,4 +684,31 @@ fn an_iceoryx2_root_too_long_for_its_sockets_is_refused() {
         .find(|p| p.key == "outputs.iceoryx2_root")
         .unwrap_or_else(|| panic!("{problems:?}"));
     assert!(problem.message.contains("108 bytes"), "{}", problem.message);
+}
+
+#[test]
+fn severity_names_the_machine_group_and_foundation_and_refuses_others() {
+    use bearingd::analysis::iso::{Foundation, MachineGroup};
+    let config = config::parse(
+        &format!("{SENSOR}[severity]\nmachine_group = 1\nfoundation = \"flexible\"\n"),
+        "test.toml",
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        (config.severity.group, config.severity.foundation),
+        (MachineGroup::Large, Foundation::Flexible)
+    );
+    let found = problems(&format!(
+        "{SENSOR}[sensors.sim]\nimbalance_g = -1.0\n[severity]\nmachine_group = 3\nfoundation = \"concrete\"\n"
+    ));
+    assert_eq!(
+        keys(&found),
+        [
+            "sensors[0].sim.imbalance_g",
+            "severity.machine_group",
+            "severity.foundation"
+        ],
+        "{found:#?}"
+    );
+    found.iter().for_each(assert_has_fix);
 }

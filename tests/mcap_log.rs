@@ -139,6 +139,25 @@ fn every_type() -> Vec<PipelineMessage> {
             given_rpm: None,
             rpm: None,
         }),
+        PipelineMessage::Velocity(VelocityMessage {
+            channel: ch("motor-de", "radial"),
+            end_sample: 32_768,
+            rms_mm_s: 3.745,
+            zone: IsoZone::C,
+            band_hz: [10.0, 1000.0],
+            windows_averaged: 1,
+            flag: FlagLevel::Ok,
+        }),
+        PipelineMessage::VelocityFlag(VelocityFlagMessage {
+            channel: ch("motor-de", "radial"),
+            end_sample: 163_840,
+            from: FlagLevel::Ok,
+            to: FlagLevel::Watch,
+            rms_mm_s: 3.75,
+            zone: IsoZone::C,
+            watch_mm_s: 2.8,
+            alarm_mm_s: 4.5,
+        }),
     ]
 }
 
@@ -153,6 +172,8 @@ fn topic_and_json(m: &PipelineMessage) -> (String, String) {
         PipelineMessage::Health(s) => (format!("/health/{}", s.channel), j(s)),
         PipelineMessage::Ingest(s) => (format!("/ingest/{}", s.source), j(s)),
         PipelineMessage::Speed(s) => (format!("/speed/{}", s.channel), j(s)),
+        PipelineMessage::Velocity(s) => (format!("/velocity/{}", s.channel), j(s)),
+        PipelineMessage::VelocityFlag(s) => (format!("/velocity_flags/{}", s.channel), j(s)),
     }
 }
 

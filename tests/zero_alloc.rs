@@ -119,6 +119,8 @@ fn a_monitor_takes_hops_and_speed_changes_without_allocating() {
             known_at_start: true,
             max_shaft_hz: shaft * 1.5,
         },
+        // The velocity severity (ISO zones) and its flag run every half window too.
+        severity: Some(bearingd::analysis::iso::SeveritySettings::default()),
     };
     let mut monitor = ChannelMonitor::new(settings, params.frequencies(), None);
     let counts: Vec<i16> = Simulator::record(params, 20.0)

@@ -21,6 +21,7 @@
 
 use super::envelope::{hop_samples, window_starts, FftPlans};
 use super::flags::FlagSettings;
+use crate::messages::IsoZone;
 use realfft::RealToComplex;
 use rustfft::num_complex::Complex32;
 use serde::Serialize;
@@ -86,38 +87,7 @@ impl Foundation {
     }
 }
 
-/// The evaluation zones: A newly commissioned, B unrestricted long-term operation, C limited
-/// operation (plan a repair), D damage likely.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
-pub enum Zone {
-    A,
-    B,
-    C,
-    D,
-}
-
-impl Zone {
-    pub fn letter(self) -> &'static str {
-        match self {
-            Zone::A => "A",
-            Zone::B => "B",
-            Zone::C => "C",
-            Zone::D => "D",
-        }
-    }
-
-    /// What the standard says the zone means, in a few words.
-    pub fn meaning(self) -> &'static str {
-        match self {
-            Zone::A => "newly commissioned",
-            Zone::B => "unrestricted long-term operation",
-            Zone::C => "not for long-term operation: plan a repair",
-            Zone::D => "severe enough to cause damage",
-        }
-    }
-}
-
-/// Zone boundaries, velocity RMS in mm/s.
+/// IsoZone boundaries, velocity RMS in mm/s.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ZoneLimits {
     pub ab_mm_s: f64,
@@ -143,15 +113,15 @@ impl ZoneLimits {
     }
 
     /// The zone of a velocity RMS; a value on a boundary belongs to the zone above.
-    pub fn zone(&self, v_mm_s: f64) -> Zone {
+    pub fn zone(&self, v_mm_s: f64) -> IsoZone {
         if v_mm_s < self.ab_mm_s {
-            Zone::A
+            IsoZone::A
         } else if v_mm_s < self.bc_mm_s {
-            Zone::B
+            IsoZone::B
         } else if v_mm_s < self.cd_mm_s {
-            Zone::C
+            IsoZone::C
         } else {
-            Zone::D
+            IsoZone::D
         }
     }
 
@@ -324,7 +294,7 @@ pub struct VelocitySeverity {
     /// Velocity RMS in the band, mm/s.
     pub rms_mm_s: f64,
     pub band_hz: [f64; 2],
-    pub zone: Zone,
+    pub zone: IsoZone,
     pub limits: ZoneLimits,
     pub settings: SeveritySettings,
     pub window_samples: usize,
@@ -353,7 +323,7 @@ impl VelocitySeverity {
             self.rms_mm_s,
             self.band_hz[0],
             self.band_hz[1],
-            self.zone.letter(),
+            self.zone.name(),
             self.zone.meaning(),
             self.settings.group.number(),
             self.settings.foundation.name(),
@@ -416,7 +386,9 @@ pub struct VelocityReading {
     /// One past the last sample the reading covers (sample time).
     pub end_sample: u64,
     pub rms_mm_s: f64,
-    pub zone: Zone,
+    pub zone: IsoZone,
+    /// Windows in the mean (fewer than the tracker's `averages` just after a start or gap).
+    pub windows_averaged: usize,
 }
 
 /// The velocity RMS of one channel, updated every hop over the last `averages` windows, for
@@ -424,12 +396,13 @@ pub struct VelocityReading {
 /// allocates nothing.
 pub struct VelocityTracker {
     integrator: VelocityIntegrator,
+    band: (f64, f64),
     limits: ZoneLimits,
     /// The last `window` samples, circular; `ring_pos` is where the oldest sample sits.
     ring: Vec<f32>,
     ring_pos: usize,
     hop: usize,
-    /// Samples pushed since the start.
+    /// One past the last sample pushed, in the channel's sample time.
     samples: u64,
     /// Samples until the next hop ends.
     to_next_hop: usize,
@@ -458,6 +431,7 @@ impl VelocityTracker {
         let hop = hop_samples(window, 0.5);
         VelocityTracker {
             integrator,
+            band,
             limits: ZoneLimits::of(settings.group, settings.foundation),
             ring: vec![0.0; window],
             ring_pos: 0,
@@ -478,11 +452,25 @@ impl VelocityTracker {
         self.limits
     }
 
-    /// Feeds a block of acceleration samples (g); returns the newest reading if a hop ended
-    /// inside the block.
-    pub fn push(&mut self, block: &[f32]) -> Option<VelocityReading> {
+    /// The measurement band, Hz.
+    pub fn band(&self) -> (f64, f64) {
+        self.band
+    }
+
+    /// Starts again at `first_sample` of the channel's sample time (after a gap or a sensor
+    /// restart): the next reading comes one whole window later, from new windows only.
+    pub fn restart_at(&mut self, first_sample: u64) {
+        self.samples = first_sample;
+        self.to_next_hop = self.ring.len();
+        self.ring_pos = 0;
+        self.history_len = 0;
+        self.history_pos = 0;
+    }
+
+    /// Feeds a block of acceleration samples (g); hands every reading whose hop ends inside
+    /// the block to `on_reading`, in order.
+    pub fn push(&mut self, block: &[f32], mut on_reading: impl FnMut(VelocityReading)) {
         let mut rest = block;
-        let mut reading = None;
         while !rest.is_empty() {
             let take = rest.len().min(self.to_next_hop);
             self.write(&rest[..take]);
@@ -491,10 +479,9 @@ impl VelocityTracker {
             self.to_next_hop -= take;
             if self.to_next_hop == 0 {
                 self.to_next_hop = self.hop;
-                reading = Some(self.update());
+                on_reading(self.update());
             }
         }
-        reading
     }
 
     fn write(&mut self, samples: &[f32]) {
@@ -520,6 +507,7 @@ impl VelocityTracker {
             end_sample: self.samples,
             rms_mm_s,
             zone: self.limits.zone(rms_mm_s),
+            windows_averaged: self.history_len,
         }
     }
 }
@@ -559,7 +547,7 @@ mod tests {
             let s = severity(&sine(1.0, 100.0, fs, 10.0), fs, 1800.0);
             let err = (s.rms_mm_s - want).abs() / want;
             assert!(err < 0.005, "fs {fs}: {} vs {want} mm/s", s.rms_mm_s);
-            assert_eq!(s.zone, Zone::D);
+            assert_eq!(s.zone, IsoZone::D);
             assert_eq!(s.band_hz, [10.0, 1000.0]);
             assert!(s.low_edge_resolved);
         }
@@ -621,7 +609,14 @@ mod tests {
         let medium_rigid = ZoneLimits::of(MachineGroup::Medium, Foundation::Rigid);
         assert_eq!(
             [0.5, 1.4, 2.0, 2.8, 4.49, 4.5].map(|v| medium_rigid.zone(v)),
-            [Zone::A, Zone::B, Zone::B, Zone::C, Zone::C, Zone::D]
+            [
+                IsoZone::A,
+                IsoZone::B,
+                IsoZone::B,
+                IsoZone::C,
+                IsoZone::C,
+                IsoZone::D
+            ]
         );
         let large_flexible = ZoneLimits::of(MachineGroup::Large, Foundation::Flexible);
         assert_eq!(
@@ -632,14 +627,14 @@ mod tests {
             ),
             (3.5, 7.1, 11.0)
         );
-        assert_eq!(large_flexible.zone(10.0), Zone::C);
+        assert_eq!(large_flexible.zone(10.0), IsoZone::C);
         assert_eq!(
             ZoneLimits::of(MachineGroup::Large, Foundation::Rigid).zone(4.0),
-            Zone::B
+            IsoZone::B
         );
         assert_eq!(
             ZoneLimits::of(MachineGroup::Medium, Foundation::Flexible).zone(7.1),
-            Zone::D
+            IsoZone::D
         );
     }
 
@@ -663,7 +658,7 @@ mod tests {
         let loud = sine(0.4, 100.0, fs, 6.0); // 4.4 mm/s: zone C
         let mut readings = Vec::new();
         for block in quiet.chunks(750).chain(loud.chunks(750)) {
-            readings.extend(tracker.push(block));
+            tracker.push(block, |r| readings.push(r));
         }
         let hop = tracker.window() as u64 / 2;
         assert!(readings
@@ -672,10 +667,10 @@ mod tests {
         let first = readings[0];
         let want = analytic_mm_s(0.05, 100.0);
         assert!((first.rms_mm_s - want).abs() / want < 0.01, "{first:?}");
-        assert_eq!(first.zone, Zone::A);
+        assert_eq!(first.zone, IsoZone::A);
         let last = readings.last().unwrap();
         assert!((last.rms_mm_s - analytic_mm_s(0.4, 100.0)).abs() < 0.05);
-        assert_eq!(last.zone, Zone::C);
+        assert_eq!(last.zone, IsoZone::C);
 
         let like = FlagSettings {
             watch_score: 0.0,

@@ -27,6 +27,13 @@
 //!   effect at a sample, so a replay that feeds the logged changes at their samples repeats
 //!   every event.
 //!
+//! - Velocity severity ([`super::iso`]): every half window of the velocity analysis (1.28 s
+//!   windows at 25.6 kHz) the velocity RMS in the ISO band over the last `averages` windows,
+//!   its zone, and a zone flag (watch in zone C, alarm in zone D) on the fault flags'
+//!   [`FaultFlag`] with their clear ratio and delays. Independent of the speed (the band is
+//!   chosen once, from the starting speed) and of the band selection: it runs from the first
+//!   window on.
+//!
 //! - Band selections run as jobs ([`super::band_selection`]): inline by default; with
 //!   [`ChannelMonitor::with_band_selector`] on another thread, their results used a fixed number
 //!   of samples after they started, so that the analysis never waits 30–100 ms for one.
@@ -42,6 +49,7 @@ use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::{FaultFlag, FlagChange, FlagSettings};
 use super::health::{Baseline, HealthTracker, StageChange, CONFIRM_WINDOWS};
 use super::indicators::Indicators;
+use super::iso::{SeveritySettings, VelocityReading, VelocityTracker, ZoneLimits};
 use super::record::envelope_range_hz;
 use super::speed::SpeedSearch;
 use super::{AnalysisSettings, Band};
@@ -69,6 +77,8 @@ pub struct MonitorSettings {
     pub flat_line_samples: u64,
     /// Where the shaft speed comes from.
     pub speed: SpeedMode,
+    /// The machine the velocity zones are judged for; `None`: no velocity analysis.
+    pub severity: Option<SeveritySettings>,
 }
 
 /// Where a channel's shaft speed comes from.
@@ -148,6 +158,18 @@ pub enum MonitorEvent<'a> {
         bands: [Band; 4],
         selected: Band,
     },
+    /// A velocity reading ([`super::iso`]) and the zone flag's level after it.
+    Velocity {
+        reading: VelocityReading,
+        band_hz: (f64, f64),
+        flag: FlagLevel,
+    },
+    /// The velocity zone flag changed level.
+    VelocityFlag {
+        change: FlagChange,
+        reading: VelocityReading,
+        limits: ZoneLimits,
+    },
     /// Samples were missing: the windows restart after the gap.
     Gap {
         at_sample: u64,
@@ -207,6 +229,8 @@ pub struct ChannelMonitor {
     band_delay_samples: u64,
     /// Where the band selection under way (if any) is used.
     band_result_at: Option<u64>,
+    /// The velocity severity and its zone flag (`None` when off).
+    velocity: Option<(VelocityTracker, FaultFlag)>,
 }
 
 /// Samples converted per chunk (the scratch buffer's size).
@@ -241,7 +265,19 @@ impl ChannelMonitor {
             bins,
         );
         let scores = scorer.score_all(&[], bin_hz, &freqs);
+        let velocity = settings.severity.map(|severity| {
+            let tracker = VelocityTracker::new(
+                settings.fs_hz,
+                freqs.shaft * 60.0,
+                severity,
+                settings.analysis.averages,
+                &mut crate::analysis::envelope::FftPlans::default(),
+            );
+            let flag = FaultFlag::new(tracker.limits().flag_settings(&settings.flags));
+            (tracker, flag)
+        });
         ChannelMonitor {
+            velocity,
             rolling: RollingEnvelope::new(
                 settings.fs_hz,
                 window,
@@ -374,6 +410,11 @@ impl ChannelMonitor {
         self.flags.each_ref().map(|f| f.level())
     }
 
+    /// The velocity zone flag's level; `None` when the velocity analysis is off.
+    pub fn velocity_flag(&self) -> Option<FlagLevel> {
+        self.velocity.as_ref().map(|(_, flag)| flag.level())
+    }
+
     pub fn health(&self) -> &HealthTracker {
         &self.health
     }
@@ -413,6 +454,9 @@ impl ChannelMonitor {
                 });
             }
             self.rolling.restart_at(first_sample);
+            if let Some((tracker, _)) = &mut self.velocity {
+                tracker.restart_at(first_sample);
+            }
             self.history_filled = 0;
             self.next_sample = first_sample;
             self.last_count = None;
@@ -486,6 +530,25 @@ impl ChannelMonitor {
         }
         self.history_filled = (self.history_filled + samples.len()).min(n);
         self.next_sample += samples.len() as u64;
+
+        if let Some((tracker, flag)) = &mut self.velocity {
+            let band_hz = tracker.band();
+            let limits = tracker.limits();
+            tracker.push(samples, |reading| {
+                if let Some(change) = flag.update(reading.rms_mm_s, reading.end_sample) {
+                    on_event(MonitorEvent::VelocityFlag {
+                        change,
+                        reading,
+                        limits,
+                    });
+                }
+                on_event(MonitorEvent::Velocity {
+                    reading,
+                    band_hz,
+                    flag: flag.level(),
+                });
+            });
+        }
 
         let rule = self.settings.analysis.decision_rule();
         let ChannelMonitor {

@@ -48,6 +48,18 @@ impl Sink for FlagPrinter {
                 "FLAG {}: {} {} -> {} (score {:.1}, {:.1} Hz) at sample {}",
                 f.channel, f.fault, f.from, f.to, f.score, f.fault_frequency_hz, f.end_sample
             ),
+            PipelineMessage::VelocityFlag(f) => println!(
+                "FLAG {}: {} {} -> {} (ISO velocity {:.2} mm/s, zone {}; C from {}, D from {} mm/s) at sample {}",
+                f.channel,
+                crate::messages::VELOCITY_FLAG_NAME,
+                f.from,
+                f.to,
+                f.rms_mm_s,
+                f.zone,
+                f.watch_mm_s,
+                f.alarm_mm_s,
+                f.end_sample
+            ),
             PipelineMessage::Health(h) if h.kind != HealthKind::Bands => {
                 println!(
                     "HEALTH {}: {} at sample {}",
@@ -374,8 +386,12 @@ pub fn status_line(s: &ChannelStatus) -> String {
         (None, SpeedSource::Estimate) => "?(no estimate yet: scoring waits)".to_string(),
         (None, _) => "?(no usable speed frame: scoring waits)".to_string(),
     };
+    let iso = match (s.zone, s.velocity_mm_s) {
+        (Some(zone), Some(v)) => format!("{zone}({v:.2}mm/s)"),
+        _ => "-".into(),
+    };
     format!(
-        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} flags={}{}{}",
+        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} iso={} flags={}{}{}",
         s.channel,
         s.seconds,
         rpm,
@@ -383,6 +399,7 @@ pub fn status_line(s: &ChannelStatus) -> String {
         top,
         twin,
         s.stage,
+        iso,
         s.flags_summary(),
         if s.gaps > 0 {
             format!(" GAPS {} ({} samples missing)", s.gaps, s.missing_samples)

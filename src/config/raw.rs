@@ -62,6 +62,7 @@ pub(crate) struct RawConfig {
     pub thresholds: RawThresholds,
     pub outputs: RawOutputs,
     pub fleet: RawFleet,
+    pub severity: RawSeverity,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -112,6 +113,7 @@ pub(crate) struct RawSim {
     pub onset_s: Field<f64>,
     pub severity: Field<f64>,
     pub noise_g: Field<f64>,
+    pub imbalance_g: Field<f64>,
     pub seed: Field<i64>,
 }
 
@@ -166,6 +168,14 @@ pub(crate) struct RawOutputs {
     pub iceoryx2_root: Field<String>,
     pub status_interval_s: Field<f64>,
     pub state_save_interval_s: Field<f64>,
+}
+
+/// `[severity]`: the machine the ISO 10816-3 / 20816-3 velocity zones are judged for.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct RawSeverity {
+    pub machine_group: Field<i64>,
+    pub foundation: Field<String>,
 }
 
 /// `[fleet]`: the fleet bridge over MQTT Sparkplug B.

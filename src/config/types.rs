@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
+use crate::analysis::iso::SeveritySettings;
 use crate::analysis::AnalysisSettings;
 use crate::bearing::BearingGeometry;
 use crate::messages::SpeedSource;
@@ -27,6 +28,8 @@ pub struct Config {
     pub outputs: OutputConfig,
     /// The fleet bridge over MQTT (`[fleet]`); `None` when it is off (the default).
     pub fleet: Option<FleetConfig>,
+    /// The machine group and foundation of the ISO velocity zones (`[severity]`).
+    pub severity: SeveritySettings,
 }
 
 impl Config {
@@ -111,6 +114,8 @@ pub struct SimConfig {
     pub severity: f64,
     /// Standard deviation of the added white noise, in g; in [0, 100].
     pub noise_g: f64,
+    /// Amplitude of the once-per-revolution (imbalance) tone, in g; in [0, 100].
+    pub imbalance_g: f64,
     /// Seed of the simulator's random numbers (noise, slip jitter).
     pub seed: u64,
 }
@@ -122,6 +127,7 @@ impl Default for SimConfig {
             onset_s: 30.0,
             severity: 1.0,
             noise_g: 0.05,
+            imbalance_g: 0.05,
             seed: 1,
         }
     }

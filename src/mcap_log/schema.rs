@@ -20,7 +20,7 @@ use serde_json::{json, Value};
 
 use crate::messages::{
     ChannelId, FlagMessage, HealthMessage, IndicatorsMessage, IngestMessage, PipelineMessage,
-    RawBlock, SpectrumMessage, SpeedMessage, TwinMessage,
+    RawBlock, SpectrumMessage, SpeedMessage, TwinMessage, VelocityFlagMessage, VelocityMessage,
 };
 use schemars::generate::SchemaSettings;
 use schemars::transform::transform_subschemas;
@@ -150,10 +150,12 @@ pub enum JsonKind {
     Health,
     Ingest,
     Speed,
+    Velocity,
+    VelocityFlag,
 }
 
 impl JsonKind {
-    pub const ALL: [JsonKind; 7] = [
+    pub const ALL: [JsonKind; 9] = [
         JsonKind::Spectrum,
         JsonKind::Indicators,
         JsonKind::Twin,
@@ -161,6 +163,8 @@ impl JsonKind {
         JsonKind::Health,
         JsonKind::Ingest,
         JsonKind::Speed,
+        JsonKind::Velocity,
+        JsonKind::VelocityFlag,
     ];
 
     /// The schema name recorded in the file (also Foxglove's datatype name).
@@ -173,6 +177,8 @@ impl JsonKind {
             JsonKind::Health => "bearingd.Health",
             JsonKind::Ingest => "bearingd.Ingest",
             JsonKind::Speed => "bearingd.Speed",
+            JsonKind::Velocity => "bearingd.Velocity",
+            JsonKind::VelocityFlag => "bearingd.VelocityFlag",
         }
     }
 
@@ -197,6 +203,8 @@ impl JsonKind {
             JsonKind::Health => generator.into_root_schema_for::<HealthMessage>(),
             JsonKind::Ingest => generator.into_root_schema_for::<IngestMessage>(),
             JsonKind::Speed => generator.into_root_schema_for::<SpeedMessage>(),
+            JsonKind::Velocity => generator.into_root_schema_for::<VelocityMessage>(),
+            JsonKind::VelocityFlag => generator.into_root_schema_for::<VelocityFlagMessage>(),
         };
         schema.insert("title".into(), self.schema_name().into());
         schema.to_value()
@@ -347,6 +355,21 @@ pub fn encode(
             let _ = write!(topic, "/speed/{}/{}", m.channel.sensor, m.channel.axis);
             (JsonKind::Speed, serde_json::to_writer(&mut *payload, m))
         }
+        PipelineMessage::Velocity(m) => {
+            let _ = write!(topic, "/velocity/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Velocity, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::VelocityFlag(m) => {
+            let _ = write!(
+                topic,
+                "/velocity_flags/{}/{}",
+                m.channel.sensor, m.channel.axis
+            );
+            (
+                JsonKind::VelocityFlag,
+                serde_json::to_writer(&mut *payload, m),
+            )
+        }
     };
     debug_assert!(r.is_ok());
     Some(kind)
@@ -450,6 +473,25 @@ mod tests {
                 source: SpeedSource::Can,
                 given_rpm: None,
                 rpm: Some(1797.0),
+            }),
+            PipelineMessage::Velocity(VelocityMessage {
+                channel: channel(),
+                end_sample: 32_768,
+                rms_mm_s: 3.7,
+                zone: crate::messages::IsoZone::C,
+                band_hz: [10.0, 1000.0],
+                windows_averaged: 8,
+                flag: FlagLevel::Watch,
+            }),
+            PipelineMessage::VelocityFlag(VelocityFlagMessage {
+                channel: channel(),
+                end_sample: 65_536,
+                from: FlagLevel::Ok,
+                to: FlagLevel::Watch,
+                rms_mm_s: 3.7,
+                zone: crate::messages::IsoZone::C,
+                watch_mm_s: 2.8,
+                alarm_mm_s: 4.5,
             }),
         ]
     }

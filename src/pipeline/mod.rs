@@ -30,8 +30,8 @@ use crate::bearing::FaultFrequencies;
 use crate::config::{Config, SensorConfig, Speed};
 use crate::messages::{
     ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage, HealthStage,
-    IndicatorsMessage, IngestMessage, PipelineMessage, RawBlock, SpectrumMessage, SpeedMessage,
-    SpeedSource,
+    IndicatorsMessage, IngestMessage, IsoZone, PipelineMessage, RawBlock, SpectrumMessage,
+    SpeedMessage, SpeedSource, VelocityFlagMessage, VelocityMessage, VELOCITY_FLAG_NAME,
 };
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -110,15 +110,22 @@ pub struct ChannelStatus {
     pub twin_error: Option<f64>,
     pub sensor_lost: bool,
     pub flag_changes: u64,
+    /// The latest ISO velocity RMS (mm/s) and its zone; `None` before the first reading.
+    pub velocity_mm_s: Option<f64>,
+    pub zone: Option<IsoZone>,
+    /// The velocity zone flag (watch in zone C, alarm in zone D).
+    pub zone_flag: FlagLevel,
 }
 
 impl ChannelStatus {
-    /// The raised flags as `fault=level` joined by commas (`outer_race=alarm,ball=watch`), or
-    /// `ok` when none is raised.
+    /// The raised flags as `fault=level` joined by commas (`outer_race=alarm,ball=watch`, the
+    /// velocity zone flag as `iso_zone=watch`), or `ok` when none is raised.
     pub fn flags_summary(&self) -> String {
         let raised: Vec<String> = FaultKind::ALL
             .iter()
+            .map(|f| f.name())
             .zip(&self.flags)
+            .chain([(VELOCITY_FLAG_NAME, &self.zone_flag)])
             .filter(|(_, level)| **level != FlagLevel::Ok)
             .map(|(fault, level)| format!("{fault}={level}"))
             .collect();
@@ -193,6 +200,7 @@ pub fn monitor_settings(
                 range: search,
             }),
         },
+        severity: Some(config.severity),
     }
 }
 
@@ -301,6 +309,9 @@ impl Pipeline {
                     twin_error: None,
                     sensor_lost: false,
                     flag_changes: 0,
+                    velocity_mm_s: None,
+                    zone: None,
+                    zone_flag: FlagLevel::Ok,
                 };
                 let fs_hz = sensor.sample_rate_hz;
                 channels.insert(
@@ -546,6 +557,41 @@ fn handle_event(
                 to: change.to,
                 score,
                 fault_frequency_hz: frequency_hz,
+            })
+        }
+        MonitorEvent::Velocity {
+            reading,
+            band_hz,
+            flag,
+        } => {
+            status.velocity_mm_s = Some(reading.rms_mm_s);
+            status.zone = Some(reading.zone);
+            status.zone_flag = flag;
+            PipelineMessage::Velocity(VelocityMessage {
+                channel: channel.clone(),
+                end_sample: reading.end_sample,
+                rms_mm_s: reading.rms_mm_s,
+                zone: reading.zone,
+                band_hz: [band_hz.0, band_hz.1],
+                windows_averaged: reading.windows_averaged,
+                flag,
+            })
+        }
+        MonitorEvent::VelocityFlag {
+            change,
+            reading,
+            limits,
+        } => {
+            status.zone_flag = change.to;
+            PipelineMessage::VelocityFlag(VelocityFlagMessage {
+                channel: channel.clone(),
+                end_sample: change.at_sample,
+                from: change.from,
+                to: change.to,
+                rms_mm_s: reading.rms_mm_s,
+                zone: reading.zone,
+                watch_mm_s: limits.bc_mm_s,
+                alarm_mm_s: limits.cd_mm_s,
             })
         }
         MonitorEvent::Stage(change) => PipelineMessage::Health(HealthMessage {

@@ -166,7 +166,7 @@ fn velocity_panel(v: &VelocitySeverity, shaft_hz: f64) -> SpectrumPanel {
         label: format!(
             "velocity {:.2} mm/s RMS, zone {}",
             v.rms_mm_s,
-            v.zone.letter()
+            v.zone.name()
         ),
         y: v.per_bin_mm2_s2.iter().map(|p| p.sqrt()).collect(),
         color: Color::BLUE,

@@ -39,6 +39,7 @@ impl SimSource {
                     fs_hz: sensor.sample_rate_hz,
                     amplitude_g: sim.severity,
                     noise_g: sim.noise_g,
+                    shaft_tone_g: sim.imbalance_g,
                     onset_s: sim.onset_s,
                     ramp_s: 10.0,
                     resonance_hz: (sensor.sample_rate_hz * 0.12).min(3_000.0),

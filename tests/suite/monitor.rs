@@ -29,6 +29,8 @@ fn settings(fs: f64) -> MonitorSettings {
         clip_count: 32_767,
         flat_line_samples: fs as u64,
         speed: SpeedMode::Fixed,
+        // The velocity severity runs too: its readings must not depend on block sizes either.
+        severity: Some(bearingd::analysis::iso::SeveritySettings::default()),
     }
 }
 
@@ -117,6 +119,14 @@ fn describe(event: MonitorEvent, events: &mut Vec<String>) {
             shaft_hz,
             ..
         } => events.push(format!("speed {shaft_hz:?} at {at_sample}")),
+        MonitorEvent::Velocity { reading, flag, .. } => events.push(format!(
+            "velocity {:.6} mm/s zone {} flag {flag} at {}",
+            reading.rms_mm_s, reading.zone, reading.end_sample
+        )),
+        MonitorEvent::VelocityFlag { change, .. } => events.push(format!(
+            "velocity flag {:?}->{:?} at {}",
+            change.from, change.to, change.at_sample
+        )),
         MonitorEvent::Window(_) => {}
     }
 }
@@ -372,4 +382,79 @@ fn a_band_phase_staggers_the_selections_after_the_first() {
             history + 2 * period + phase
         ]
     );
+}
+
+/// Issue 16 item 4 in the streaming path: a machine whose 100 Hz vibration steps from zone A
+/// (0.55 mm/s) into zone C (4.41 mm/s, group 2 rigid: C from 2.8) and back. The zone flag
+/// rises to watch once the velocity has stayed in zone C for the on-delay, and falls once it
+/// has stayed below clear_ratio × 2.8 mm/s for the off-delay, exactly once each.
+#[test]
+fn the_velocity_zone_flag_rises_and_falls_with_the_fault_flags_hysteresis() {
+    let fs = 12_000.0;
+    let sine = |amplitude_g: f64, seconds: f64, from: usize| -> Vec<i16> {
+        (from..from + (seconds * fs) as usize)
+            .map(|n| {
+                let g = amplitude_g * (std::f64::consts::TAU * 100.0 * n as f64 / fs).sin();
+                (g / SCALE).round() as i16
+            })
+            .collect()
+    };
+    let mut counts = sine(0.05, 20.0, 0);
+    counts.extend(sine(0.4, 30.0, counts.len()));
+    counts.extend(sine(0.05, 60.0, counts.len()));
+    let freqs = SimulationParams::example(SimulatedFault::None).frequencies();
+    let mut monitor = ChannelMonitor::new(settings(fs), freqs, None);
+    let (mut readings, mut changes) = (Vec::new(), Vec::new());
+    for (i, block) in counts.chunks(1_000).enumerate() {
+        monitor.push_counts((i * 1_000) as u64, block, SCALE, &mut |e| match e {
+            MonitorEvent::Velocity { reading, .. } => readings.push(reading),
+            MonitorEvent::VelocityFlag { change, limits, .. } => {
+                assert_eq!((limits.bc_mm_s, limits.cd_mm_s), (2.8, 4.5));
+                changes.push(change)
+            }
+            _ => {}
+        });
+    }
+    let (on_delay, off_delay) = ((5.0 * fs) as u64, (30.0 * fs) as u64);
+    let first_in_c = readings.iter().find(|r| r.rms_mm_s >= 2.8).unwrap();
+    let raise = readings
+        .iter()
+        .find(|r| r.end_sample >= first_in_c.end_sample + on_delay)
+        .unwrap();
+    let first_clear = readings
+        .iter()
+        .find(|r| r.end_sample > raise.end_sample && r.rms_mm_s < 0.8 * 2.8)
+        .unwrap();
+    let fall = readings
+        .iter()
+        .find(|r| r.end_sample >= first_clear.end_sample + off_delay)
+        .unwrap();
+    let got: Vec<_> = changes
+        .iter()
+        .map(|c| (c.from, c.to, c.at_sample))
+        .collect();
+    assert_eq!(
+        got,
+        [
+            (FlagLevel::Ok, FlagLevel::Watch, raise.end_sample),
+            (FlagLevel::Watch, FlagLevel::Ok, fall.end_sample)
+        ]
+    );
+    // The steady parts read the analytic velocity, a·g₀/(2πf)/√2.
+    let analytic = |a: f64| a * 9.806_65 / (std::f64::consts::TAU * 100.0) / 2f64.sqrt() * 1e3;
+    let at = |seconds: f64| {
+        readings
+            .iter()
+            .find(|r| r.end_sample as f64 >= seconds * fs)
+            .unwrap()
+            .rms_mm_s
+    };
+    for (seconds, a) in [(15.0, 0.05), (45.0, 0.4), (105.0, 0.05)] {
+        let want = analytic(a);
+        assert!(
+            (at(seconds) - want).abs() / want < 0.01,
+            "{seconds} s: {} vs {want} mm/s",
+            at(seconds)
+        );
+    }
 }

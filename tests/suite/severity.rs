@@ -143,3 +143,201 @@ fn issue16_a_wav_has_no_velocity_and_says_why() {
         "{report:#}"
     );
 }
+
+/// What `tests/python/velocity_log.py` (Python `mcap`, strict reader) finds in the logs.
+fn velocity_log(py: &Path, files: &[std::path::PathBuf]) -> Value {
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/velocity_log.py");
+    let out = Command::new(py)
+        .arg(script)
+        .args(files)
+        .output()
+        .expect("run velocity_log.py");
+    assert!(
+        out.status.success(),
+        "velocity_log.py: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).expect("JSON")
+}
+
+/// A config of the simulated node with `imbalance_g` of once-per-revolution tone and no
+/// bearing fault, logging under `dir`.
+fn imbalance_config(dir: &Path, imbalance_g: f64) -> std::path::PathBuf {
+    // Outside /tmp (the config refuses it there), short enough for iceoryx2's socket paths.
+    let iox = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("is-{}", std::process::id()));
+    let text = format!(
+        r#"[[sensors]]
+id = "motor-de"
+transport = "sim"
+sample_rate_hz = 25600
+bearing = "skf-6205-2rs"
+[sensors.speed]
+source = "fixed"
+rpm = 1772
+[sensors.sim]
+fault = "none"
+imbalance_g = {imbalance_g}
+
+[severity]
+machine_group = 2
+foundation = "rigid"
+
+[outputs]
+state_dir = "{state}"
+mcap_dir = "{mcap}"
+iceoryx2_root = "{iox}"
+"#,
+        state = dir.join("state").display(),
+        mcap = dir.join("mcap").display(),
+        iox = iox.display(),
+    );
+    let path = dir.join("bearingd.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+fn run_ok(args: &[&str]) -> String {
+    let out = bearingd(args);
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{args:?}: {stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// (from, to, end_sample) of every velocity zone flag change.
+fn zone_flags(log: &Value) -> Vec<(String, String, u64)> {
+    log["velocity_flags"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            (
+                f["from"].as_str().unwrap().to_string(),
+                f["to"].as_str().unwrap().to_string(),
+                f["end_sample"].as_u64().unwrap(),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn issue16_the_daemon_logs_velocity_and_raises_the_zone_flag_after_its_delay() {
+    let Some(py) = bearingd_testdata::python_mcap() else {
+        return;
+    };
+    let dir = scratch_dir("severity-daemon");
+    // 0.1 g at the shaft rate (29.53 Hz): 3.74 mm/s, zone C of group 2 on a rigid foundation
+    // (C from 2.8, D from 4.5 mm/s); the 0.05 g of noise adds 0.2 mm/s in quadrature.
+    let config = imbalance_config(&dir, 0.1);
+    let stdout = run_ok(&[
+        "run",
+        "--config",
+        config.to_str().unwrap(),
+        "--fast",
+        "--duration",
+        "30",
+        "--quiet",
+    ]);
+    assert!(
+        stdout.contains("FLAG motor-de/radial: iso_zone ok -> watch"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("flags=iso_zone=watch"), "{stdout}");
+    let live = bearingd_testdata::mcap_files(&dir.join("mcap"));
+    let log = velocity_log(&py, &live);
+    assert_eq!(
+        log["schemas"]["/velocity/motor-de/radial"]["name"],
+        "bearingd.Velocity"
+    );
+    assert_eq!(
+        log["schemas"]["/velocity_flags/motor-de/radial"]["name"],
+        "bearingd.VelocityFlag"
+    );
+    let readings = log["velocity"].as_array().unwrap();
+    // 32,768-sample windows (10 Hz is 8 bins up at 25.6 kHz), a reading every half window.
+    let hop = 16_384;
+    assert!(
+        readings.len() as u64 >= 30 * 25_600 / hop - 2,
+        "{}",
+        readings.len()
+    );
+    let want = analytic_mm_s(0.1, 1772.0 / 60.0);
+    for r in readings {
+        let v = r["rms_mm_s"].as_f64().unwrap();
+        assert!((v - want).abs() / want < 0.03, "{r}: want {want:.3} mm/s");
+        assert_eq!(r["zone"], "C", "{r}");
+        assert_eq!(r["band_hz"], serde_json::json!([10.0, 1000.0]));
+    }
+    // The flag rises at the first reading 5 s (on_delay_s, in samples) after the first
+    // reading in zone C, not before, and never changes again (the level holds).
+    let first_c = readings[0]["end_sample"].as_u64().unwrap();
+    let on_delay = 5 * 25_600;
+    let raised_at = readings
+        .iter()
+        .map(|r| r["end_sample"].as_u64().unwrap())
+        .find(|&s| s - first_c >= on_delay)
+        .unwrap();
+    assert_eq!(
+        zone_flags(&log),
+        [("ok".to_string(), "watch".to_string(), raised_at)]
+    );
+    for r in readings {
+        let want_flag = if r["end_sample"].as_u64().unwrap() >= raised_at {
+            "watch"
+        } else {
+            "ok"
+        };
+        assert_eq!(r["flag"], want_flag, "{r}");
+    }
+    // No bearing fault is simulated: no fault flag.
+    assert_eq!(log["fault_flags"].as_array().unwrap().len(), 0);
+
+    // A replay of the log through the same config raises the same zone flag at the same sample.
+    let replay_dir = dir.join("replay");
+    run_ok(&[
+        "replay",
+        live[0].to_str().unwrap(),
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        replay_dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    let replayed = velocity_log(&py, &bearingd_testdata::mcap_files(&replay_dir));
+    assert_eq!(zone_flags(&replayed), zone_flags(&log));
+}
+
+#[test]
+fn issue16_the_healthy_embedded_default_stays_in_zone_b_without_a_zone_flag() {
+    let Some(py) = bearingd_testdata::python_mcap() else {
+        return;
+    };
+    let dir = scratch_dir("severity-default");
+    let data = dir.join("data");
+    // The embedded default, 0.05 g of imbalance (1.87 mm/s), with its outer-race fault from
+    // 30 s: the impacts ring at 3 kHz, outside the band, and leave the velocity as it was.
+    let stdout = run_ok(&[
+        "run",
+        "--fast",
+        "--duration",
+        "60",
+        "--quiet",
+        "--data-dir",
+        data.to_str().unwrap(),
+    ]);
+    assert!(!stdout.contains("iso_zone"), "{stdout}");
+    assert!(stdout.contains("iso=B("), "{stdout}");
+    let log = velocity_log(&py, &bearingd_testdata::mcap_files(&data.join("mcap")));
+    let readings = log["velocity"].as_array().unwrap();
+    assert!(readings.len() >= 90, "{}", readings.len());
+    let want = analytic_mm_s(0.05, 1772.0 / 60.0);
+    for r in readings {
+        let v = r["rms_mm_s"].as_f64().unwrap();
+        assert!((v - want).abs() / want < 0.03, "{r}: want {want:.3} mm/s");
+        assert_eq!((&r["zone"], &r["flag"]), (&"B".into(), &"ok".into()), "{r}");
+    }
+    assert!(zone_flags(&log).is_empty());
+}

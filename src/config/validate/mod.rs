@@ -8,6 +8,7 @@ mod analysis;
 mod fleet;
 mod outputs;
 mod sensors;
+mod severity;
 mod thresholds;
 mod transports;
 mod twin;
@@ -20,8 +21,8 @@ use crate::bearing::{BearingError, BearingGeometry};
 
 use super::error::ConfigProblem;
 use super::raw::{
-    Field, Loose, RawAnalysis, RawCan, RawConfig, RawOutputs, RawSensor, RawShm, RawSim, RawSpeed,
-    RawThresholds, RawTwin,
+    Field, Loose, RawAnalysis, RawCan, RawConfig, RawOutputs, RawSensor, RawSeverity, RawShm,
+    RawSim, RawSpeed, RawThresholds, RawTwin,
 };
 use super::types::{
     CanConfig, Config, OutputConfig, SensorConfig, ShmConfig, SimConfig, SimFault, Speed,
@@ -51,9 +52,12 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
     let thresholds = check.thresholds(&raw.thresholds);
     let outputs = check.outputs(&raw.outputs, &sensors);
     let fleet = check.fleet(&raw.fleet, outputs.as_ref().map(|o| o.state_dir.as_path()));
+    let severity = check.severity(&raw.severity);
 
     let sensors: Option<Vec<SensorConfig>> = sensors.into_iter().map(|s| s.config).collect();
-    match (sensors, analysis, twin, thresholds, outputs, fleet) {
+    match (
+        sensors, analysis, twin, thresholds, outputs, fleet, severity,
+    ) {
         (
             Some(sensors),
             Some((analysis, band_period_s)),
@@ -61,6 +65,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
             Some(thresholds),
             Some(outputs),
             Some(fleet),
+            Some(severity),
         ) if check.problems.is_empty() => Ok(Config {
             sensors,
             analysis,
@@ -69,6 +74,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
             thresholds,
             outputs,
             fleet,
+            severity,
         }),
         _ => {
             if check.problems.is_empty() {

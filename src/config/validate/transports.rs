@@ -178,6 +178,13 @@ impl Checker {
             Limits::within(0.0, 100.0),
             "give the standard deviation of the added noise in g, e.g. noise_g = 0.05",
         );
+        let imbalance_g = self.number(
+            &format!("{key}.imbalance_g"),
+            &raw.imbalance_g,
+            defaults.imbalance_g,
+            Limits::within(0.0, 100.0),
+            "give the amplitude of the once-per-revolution tone in g, e.g. imbalance_g = 0.05",
+        );
         let seed_fix = "give a whole number of 0 or more, e.g. seed = 1";
         let seed = self
             .integer(
@@ -194,6 +201,7 @@ impl Checker {
             onset_s: onset_s?,
             severity: severity?,
             noise_g: noise_g?,
+            imbalance_g: imbalance_g?,
             seed: seed?,
         })
     }

@@ -81,8 +81,20 @@ pub fn fault_code(fault: FaultKind) -> u8 {
     }
 }
 
-fn fault_of_code(code: u8) -> Option<FaultKind> {
-    FaultKind::ALL.into_iter().find(|f| fault_code(*f) == code)
+/// Code in [`Alert::fault`] of the ISO velocity zone flag (watch in zone C, alarm in zone D):
+/// `score` is then the velocity RMS in mm/s, `fault_frequency_hz` and `twin_error` NaN.
+pub const ISO_ZONE_CODE: u8 = 5;
+
+/// The wire name of a code of [`Alert::fault`]: a fault kind's (`outer_race`, …) or
+/// `iso_zone`.
+fn subject_of_code(code: u8) -> Option<&'static str> {
+    if code == ISO_ZONE_CODE {
+        return Some(crate::messages::VELOCITY_FLAG_NAME);
+    }
+    FaultKind::ALL
+        .into_iter()
+        .find(|f| fault_code(*f) == code)
+        .map(FaultKind::name)
 }
 
 /// Code of a flag level in [`Alert::severity`]: 0 ok, 1 watch, 2 alarm.
@@ -133,7 +145,7 @@ pub struct Alert {
     pub version: u32,
     /// An [`AlertState`] code.
     pub state: u8,
-    /// A fault code, see [`fault_code`].
+    /// A fault code, see [`fault_code`], or [`ISO_ZONE_CODE`].
     pub fault: u8,
     /// Severity now, see [`severity_code`]; 0 when cleared.
     pub severity: u8,
@@ -209,7 +221,7 @@ impl Alert {
             code,
         };
         let state = AlertState::from_code(self.state).ok_or(bad("state", self.state))?;
-        let fault = fault_of_code(self.fault).ok_or(bad("fault", self.fault))?;
+        let fault = subject_of_code(self.fault).ok_or(bad("fault", self.fault))?;
         let severity = severity_of_code(self.severity).ok_or(bad("severity", self.severity))?;
         let previous = severity_of_code(self.previous_severity)
             .ok_or(bad("previous_severity", self.previous_severity))?;
@@ -218,7 +230,7 @@ impl Alert {
             run_id: self.run_id,
             sensor: name_of_field(&self.sensor),
             axis: name_of_field(&self.axis),
-            fault: fault.name(),
+            fault,
             state,
             severity: severity.name(),
             previous_severity: previous.name(),
@@ -240,23 +252,28 @@ impl Alert {
 impl AlertView {
     /// One line for people: what, where, how sure, and where in the signal.
     pub fn line(&self) -> String {
-        let twin = self.twin_error.map_or("no twin fit yet".to_string(), |e| {
-            format!("twin error {e:.3}")
-        });
-        format!(
-            "#{} {}/{} {} {} ({} → {}): score {:.1} at {:.1} Hz, confidence {:.2}, {}, t = {:.1} s",
+        let head = format!(
+            "#{} {}/{} {} {} ({} → {})",
             self.sequence,
             self.sensor,
             self.axis,
             self.fault,
             self.state.name(),
             self.previous_severity,
-            self.severity,
-            self.score,
-            self.fault_frequency_hz,
-            self.confidence,
-            twin,
-            self.sample_time_s
+            self.severity
+        );
+        if self.fault == crate::messages::VELOCITY_FLAG_NAME {
+            return format!(
+                "{head}: ISO velocity {:.2} mm/s, t = {:.1} s",
+                self.score, self.sample_time_s
+            );
+        }
+        let twin = self.twin_error.map_or("no twin fit yet".to_string(), |e| {
+            format!("twin error {e:.3}")
+        });
+        format!(
+            "{head}: score {:.1} at {:.1} Hz, confidence {:.2}, {}, t = {:.1} s",
+            self.score, self.fault_frequency_hz, self.confidence, twin, self.sample_time_s
         )
     }
 }

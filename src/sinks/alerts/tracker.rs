@@ -10,10 +10,14 @@
 //! channel flapping), and a subscriber connecting then would not know it is active. So when an
 //! active alert is about to leave the window it is sent again, unchanged, as `repeated`.
 
-use super::payload::{fault_code, name_field, severity_code, Alert, AlertState, ALERT_VERSION};
+use super::payload::{
+    fault_code, name_field, severity_code, Alert, AlertState, ALERT_VERSION, ISO_ZONE_CODE,
+};
 use crate::analysis::diagnosis::{score_evidence, DecisionRule};
 use crate::analysis::AnalysisSettings;
-use crate::messages::{ChannelId, FlagMessage, IndicatorsMessage, PipelineMessage, TwinMessage};
+use crate::messages::{
+    ChannelId, FlagMessage, IndicatorsMessage, PipelineMessage, TwinMessage, VelocityFlagMessage,
+};
 use crate::messages::{FaultKind, FlagLevel};
 use crate::twin::diagnose::twin_adjusted_confidence;
 use std::collections::{BTreeMap, HashMap};
@@ -41,13 +45,15 @@ pub struct AlertTracker {
     active: BTreeMap<AlertKey, Alert>,
 }
 
-/// One alert's identity: which channel, which fault.
-type AlertKey = (ChannelId, FaultKind);
+/// One alert's identity: which channel, which fault code ([`Alert::fault`]: a fault kind or
+/// the ISO velocity zone).
+type AlertKey = (ChannelId, u8);
 
-/// History an alert service needs for `channels` analysed channels: room for every fault of
-/// every channel to be active twice over, so repeats stay rare.
+/// History an alert service needs for `channels` analysed channels: room for every flag of
+/// every channel (four faults and the velocity zone) to be active twice over, so repeats stay
+/// rare.
 pub fn history_size_for(channels: usize) -> usize {
-    (2 * FaultKind::ALL.len() * channels).max(16)
+    (2 * (FaultKind::ALL.len() + 1) * channels).max(16)
 }
 
 impl AlertTracker {
@@ -92,6 +98,11 @@ impl AlertTracker {
                     self.keep_active_in_history(wall_time_ns, publish);
                 }
             }
+            PipelineMessage::VelocityFlag(flag) => {
+                let (key, alert) = self.zone_alert_for(flag, wall_time_ns);
+                self.emit(key, alert, publish);
+                self.keep_active_in_history(wall_time_ns, publish);
+            }
             _ => {}
         }
     }
@@ -132,7 +143,6 @@ impl AlertTracker {
 
     fn alert_for(&self, flag: &FlagMessage, wall_time_ns: u64) -> Option<(AlertKey, Alert)> {
         let (fault, from, to) = (flag.fault, flag.from, flag.to);
-        let state = AlertState::of_change(from, to);
         let index = fault.index();
         let runner_up = self.scores.get(&flag.channel).map_or(1.0, |scores| {
             scores
@@ -149,32 +159,68 @@ impl AlertTracker {
                 confidence = twin_adjusted_confidence(confidence, best == fault, twin.margin);
             }
         }
-        let key = (flag.channel.clone(), fault);
-        Some((
-            key,
-            Alert {
-                sequence: 0,
-                run_id: self.run_id,
-                end_sample: flag.end_sample,
+        let alert = Alert {
+            fault_frequency_hz: flag.fault_frequency_hz,
+            score: flag.score,
+            confidence,
+            twin_error: twin.map_or(f64::NAN, |t| t.errors[index]),
+            ..self.change_alert(
+                &flag.channel,
+                flag.end_sample,
                 wall_time_ns,
-                sample_rate_hz: self
-                    .rates
-                    .get(&flag.channel.sensor)
-                    .copied()
-                    .unwrap_or(f64::NAN),
-                fault_frequency_hz: flag.fault_frequency_hz,
-                score: flag.score,
-                confidence,
-                twin_error: twin.map_or(f64::NAN, |t| t.errors[index]),
-                version: ALERT_VERSION,
-                state: state as u8,
-                fault: fault_code(fault),
-                severity: severity_code(to),
-                previous_severity: severity_code(from),
-                sensor: name_field(&flag.channel.sensor),
-                axis: name_field(&flag.channel.axis),
-            },
-        ))
+                fault_code(fault),
+                (from, to),
+            )
+        };
+        Some(((flag.channel.clone(), fault_code(fault)), alert))
+    }
+
+    /// The alert of a velocity zone flag: a measurement against the standard's boundary, not
+    /// a hypothesis, so its confidence is 1.
+    fn zone_alert_for(&self, flag: &VelocityFlagMessage, wall_time_ns: u64) -> (AlertKey, Alert) {
+        let alert = Alert {
+            score: flag.rms_mm_s,
+            confidence: 1.0,
+            ..self.change_alert(
+                &flag.channel,
+                flag.end_sample,
+                wall_time_ns,
+                ISO_ZONE_CODE,
+                (flag.from, flag.to),
+            )
+        };
+        ((flag.channel.clone(), ISO_ZONE_CODE), alert)
+    }
+
+    /// What every alert of a flag change (`from`, `to`) says: where, when, which flag (`code`,
+    /// see [`Alert::fault`]) and its state; its evidence (frequency, score, confidence, twin)
+    /// NaN, for the caller to set.
+    fn change_alert(
+        &self,
+        channel: &ChannelId,
+        end_sample: u64,
+        wall_time_ns: u64,
+        code: u8,
+        (from, to): (FlagLevel, FlagLevel),
+    ) -> Alert {
+        Alert {
+            sequence: 0,
+            run_id: self.run_id,
+            end_sample,
+            wall_time_ns,
+            sample_rate_hz: self.rates.get(&channel.sensor).copied().unwrap_or(f64::NAN),
+            fault_frequency_hz: f64::NAN,
+            score: f64::NAN,
+            confidence: f64::NAN,
+            twin_error: f64::NAN,
+            version: ALERT_VERSION,
+            state: AlertState::of_change(from, to) as u8,
+            fault: code,
+            severity: severity_code(to),
+            previous_severity: severity_code(from),
+            sensor: name_field(&channel.sensor),
+            axis: name_field(&channel.axis),
+        }
     }
 
     fn emit(&mut self, key: AlertKey, mut alert: Alert, publish: &mut impl FnMut(Alert)) {
@@ -344,6 +390,42 @@ mod tests {
         disagreeing.note_twin(&twin(InnerRace));
         let down = observe(&mut disagreeing, &raise)[0];
         assert!(down.confidence < base.confidence);
+    }
+
+    #[test]
+    fn a_velocity_zone_flag_is_an_alert_of_its_own_beside_the_fault_alerts() {
+        let mut t = tracker(16);
+        let zone = |from, to, rms_mm_s, at| {
+            PipelineMessage::VelocityFlag(VelocityFlagMessage {
+                channel: ChannelId {
+                    sensor: "motor-de".into(),
+                    axis: "radial".into(),
+                },
+                end_sample: at,
+                from,
+                to,
+                rms_mm_s,
+                zone: crate::messages::IsoZone::C,
+                watch_mm_s: 2.8,
+                alarm_mm_s: 4.5,
+            })
+        };
+        observe(&mut t, &flag("radial", OuterRace, OK, Watch, 5));
+        let raised = observe(&mut t, &zone(OK, Watch, 3.7, 10))[0];
+        let view = raised.view().unwrap();
+        assert_eq!(view.fault, "iso_zone");
+        assert_eq!((view.state, view.severity), (AlertState::Raised, "watch"));
+        assert_eq!((view.score, view.confidence), (3.7, 1.0));
+        assert!(
+            view.line().contains("ISO velocity 3.70 mm/s"),
+            "{}",
+            view.line()
+        );
+        // Both alerts are active, each under its own key.
+        assert_eq!(t.active().count(), 2);
+        let cleared = observe(&mut t, &zone(Watch, OK, 2.0, 20))[0];
+        assert_eq!(cleared.view().unwrap().state, AlertState::Cleared);
+        assert_eq!(t.active().count(), 1);
     }
 
     #[test]

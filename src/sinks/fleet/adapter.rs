@@ -145,11 +145,20 @@ impl FleetSink {
                 )
             }
             PipelineMessage::Speed(m) => (&m.channel, m.end_sample, Observed::Speed(m.rpm)),
-            // The ISO 20816 zone has a metric slot (`ISO20816/Zone`); it is filled from
-            // `Observed::IsoZone` once the pipeline emits zones.
-            PipelineMessage::Raw(_) | PipelineMessage::Spectrum(_) | PipelineMessage::Ingest(_) => {
-                return None
-            }
+            // Every reading: the metrics go at the publish period, a new zone at once.
+            PipelineMessage::Velocity(m) => (
+                &m.channel,
+                m.end_sample,
+                Observed::IsoZone {
+                    zone: m.zone.name().to_string(),
+                    velocity_mm_s: m.rms_mm_s,
+                },
+            ),
+            // The zone flag follows the zone (the zone metric changes first, and at once).
+            PipelineMessage::Raw(_)
+            | PipelineMessage::Spectrum(_)
+            | PipelineMessage::Ingest(_)
+            | PipelineMessage::VelocityFlag(_) => return None,
         };
         if let PipelineMessage::Indicators(_) = message {
             // The tracker needs every window's scores for the confidence of the next flag.

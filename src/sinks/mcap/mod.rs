@@ -213,6 +213,8 @@ impl McapSink {
             PipelineMessage::Flag(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Health(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Speed(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Velocity(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::VelocityFlag(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Ingest(_) => self.last_ns,
         }
     }

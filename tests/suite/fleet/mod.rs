@@ -98,6 +98,15 @@ fn birth_data_rebirth_and_death_on_kill_9_then_a_restart_and_a_clean_stop() {
         rms.len() >= 3 && rms.iter().all(|r| *r > 0.0 && *r < 100.0),
         "{rms:?}"
     );
+    // The ISO 10816-3 velocity zone and its velocity (issue 16 item 4), from the pipeline.
+    let zoned = data
+        .iter()
+        .find(|d| metric(d, "ISO20816/Zone").is_some_and(Value::is_string))
+        .unwrap_or_else(|| panic!("no DDATA with ISO20816/Zone: {data:?}"));
+    let zone = metric(zoned, "ISO20816/Zone").and_then(Value::as_str);
+    assert!(matches!(zone, Some("A" | "B" | "C" | "D")), "{zoned}");
+    let velocity = metric(zoned, "ISO20816/VelocityRMS_mm_s").and_then(Value::as_f64);
+    assert!(velocity.is_some_and(|v| v > 0.0 && v < 100.0), "{zoned}");
     let raised = data
         .iter()
         .find(|d| metric(d, "Fault/outer_race/Flag").is_some_and(|f| f != "ok"))
