@@ -15,7 +15,9 @@
 //! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
 //!   SNR, speed and bearing through the real pipeline (`bearingd evaluate`).
 //! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
-//! - [`report`]: what `analyze` shows: JSON, text and the figure, from one report.
+//! - [`report`]: what `analyze` and `trend` show: JSON, text and the figure, from one report.
+//! - [`life`]: a bearing's life of snapshots, in time order, through the daemon's health tracker
+//!   with the HW residual, the fault score and the RMS trend (`bearingd trend`).
 //! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
 //! - [`pipeline`]: the per-channel pipeline shared by `run` and `replay`, its outputs, the twin's
 //!   re-fit requests (served per channel in turn), the band-selection worker and the
@@ -51,6 +53,7 @@ pub mod config;
 pub mod daemon;
 pub mod evaluate;
 pub mod iox;
+pub mod life;
 pub mod mcap_log;
 pub mod messages;
 pub mod offline;

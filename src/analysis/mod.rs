@@ -13,8 +13,8 @@
 //! - [`record`]: all of the above over one whole record (`bearingd analyze`).
 //! - [`speed`]: the shaft speed estimated from the spectrum near a nominal speed.
 //! - [`iso`]: velocity severity and zones after ISO 10816-3 / 20816-3.
-//! - [`life`], [`degradation`]: a life of snapshots through the health tracker, and the
-//!   trend of RMS with its time to the failure limit (`bearingd trend`).
+//! - [`degradation`]: the trend of RMS over life with its time to the failure limit (a life
+//!   of snapshots is walked by `offline::life`, which also needs the twin).
 
 pub mod band;
 pub mod band_selection;
@@ -27,7 +27,6 @@ pub mod health;
 pub mod indicators;
 pub mod iso;
 pub mod kurtogram;
-pub mod life;
 pub mod monitor;
 pub mod record;
 pub mod settings;

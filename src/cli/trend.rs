@@ -10,7 +10,7 @@
 
 use super::{CliError, RecordingArgs};
 use crate::analysis::health::CONFIRM_WINDOWS;
-use crate::analysis::life::{hindsight, LifeSettings, LifeTracker};
+use crate::life::{hindsight, LifeSettings, LifeTracker};
 use crate::offline::{resolve_conditions, AnalyzeRequest, OfflineError};
 use crate::recording::{read_recording, time_from_name};
 use crate::report::{life_figure, render_life_text, LifeReport, LifeSettingsReport, SkippedFile};

@@ -2,7 +2,7 @@
 //! document, the text summary and the figure (stage timeline with RMS, kurtosis, HW residual and
 //! fault score, and the RMS trend with its band), so they always agree.
 
-use crate::analysis::life::{LifePoint, StageEvent, TrendHindsight};
+use crate::life::{LifePoint, StageEvent, TrendHindsight};
 use crate::messages::HealthStage;
 use crate::plot::{Color, Figure, Marker, Series, Shade, SpectrumPanel};
 use serde::Serialize;

@@ -2,9 +2,9 @@
 //! the indicators (RMS, kurtosis), the Hammerstein–Wiener model's residual (seed 003) and the
 //! envelope fault score; the daemon's own [`HealthTracker`] turning them into stages (healthy →
 //! degrading → failing); and a trend of RMS with the time it will take to reach the failure
-//! limit ([`super::degradation`]).
+//! limit ([`crate::analysis::degradation`]).
 //!
-//! Why a separate driver and not the daemon's [`super::monitor::ChannelMonitor`]: run-to-failure
+//! Why a separate driver and not the daemon's [`crate::analysis::monitor::ChannelMonitor`]: run-to-failure
 //! data comes as short snapshots far apart (PRONOSTIA: 0.1 s every 10 s), not as a continuous
 //! stream, so one snapshot is one window of the tracker. The tracker is the same type with the
 //! same 3σ rule and the same confirmation count as the daemon's; what differs, and why, is
@@ -20,11 +20,11 @@
 //!
 //! Sans-IO: the caller reads the files and says when each snapshot was taken.
 
-use super::degradation::TrendFit;
-use super::health::{HealthTracker, CONFIRM_WINDOWS};
-use super::indicators::Indicators;
-use super::record::RecordAnalyzer;
-use super::AnalysisSettings;
+use crate::analysis::degradation::TrendFit;
+use crate::analysis::health::{HealthTracker, CONFIRM_WINDOWS};
+use crate::analysis::indicators::Indicators;
+use crate::analysis::record::RecordAnalyzer;
+use crate::analysis::AnalysisSettings;
 use crate::bearing::FaultFrequencies;
 use crate::messages::{FaultKind, HealthStage};
 use crate::twin::hw::{identify_record, HwConfig};
@@ -240,7 +240,7 @@ impl LifeTracker {
         let baseline = self.health.baseline();
         let stage = self.health.stage();
         let sigma = self.settings.sigma;
-        let learned = |s: &super::health::RunningStats| {
+        let learned = |s: &crate::analysis::health::RunningStats| {
             (s.count >= self.settings.baseline_snapshots.max(2)).then(|| s.mean + sigma * s.std())
         };
         let kurtosis_limit = (stage != HealthStage::Learning)
