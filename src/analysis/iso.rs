@@ -24,14 +24,14 @@ use super::flags::FlagSettings;
 use crate::messages::IsoZone;
 use realfft::RealToComplex;
 use rustfft::num_complex::Complex32;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
 /// Standard gravity, m/s² per g.
 pub const G: f64 = 9.806_65;
 
 /// The machine groups of ISO 10816-3 / 20816-3.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum MachineGroup {
     /// Group 1: large machines, rated power above 300 kW (electrical machines with shaft
@@ -63,7 +63,7 @@ impl MachineGroup {
 
 /// The support of the machine: rigid (lowest natural frequency of machine and support above
 /// 1.25 × the main excitation) or flexible.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Foundation {
     Rigid,
@@ -138,7 +138,7 @@ impl ZoneLimits {
 }
 
 /// Which machine is measured: its group and foundation.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct SeveritySettings {
     pub group: MachineGroup,
     pub foundation: Foundation,

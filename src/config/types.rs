@@ -28,7 +28,9 @@ pub struct Config {
     pub outputs: OutputConfig,
     /// The fleet bridge over MQTT (`[fleet]`); `None` when it is off (the default).
     pub fleet: Option<FleetConfig>,
-    /// The machine group and foundation of the ISO velocity zones (`[severity]`).
+    /// The machine group and foundation of the ISO velocity zones (`[severity]`). Logs written
+    /// before the section existed have none: read as the default.
+    #[serde(default)]
     pub severity: SeveritySettings,
 }
 
@@ -114,10 +116,16 @@ pub struct SimConfig {
     pub severity: f64,
     /// Standard deviation of the added white noise, in g; in [0, 100].
     pub noise_g: f64,
-    /// Amplitude of the once-per-revolution (imbalance) tone, in g; in [0, 100].
+    /// Amplitude of the once-per-revolution (imbalance) tone, in g; in [0, 100]. Logs written
+    /// before the key existed have none: read as the default, what the simulator made then.
+    #[serde(default = "default_imbalance_g")]
     pub imbalance_g: f64,
     /// Seed of the simulator's random numbers (noise, slip jitter).
     pub seed: u64,
+}
+
+fn default_imbalance_g() -> f64 {
+    SimConfig::default().imbalance_g
 }
 
 impl Default for SimConfig {

@@ -282,6 +282,7 @@ pub fn differences(logged: &Config, given: &Config) -> Vec<String> {
         ),
         ("[twin]", logged.twin == given.twin),
         ("[thresholds]", logged.thresholds == given.thresholds),
+        ("[severity]", logged.severity == given.severity),
     ] {
         if !same {
             out.push(format!("{section} differs"));
