@@ -147,7 +147,9 @@ fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_
     let data = dir.join("data");
     let root = format!("/dev/shm/bearingd-lifecycle-rot-{}", std::process::id());
     let config = config_file(&dir, |text| {
+        // Twice the default imbalance: ISO zone C, so the zone flag rises early (state too).
         text.replace("mcap_max_file_mb = 256", "mcap_max_file_mb = 1")
+            .replace("imbalance_g = 0.05", "imbalance_g = 0.1")
             .replace("\"/run/bearingd/iceoryx2\"", &format!("\"{root}\""))
     });
     let out = bearingd(&[
@@ -169,7 +171,9 @@ fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_
     let mut flags = BTreeMap::new();
     let mut health = BTreeMap::new();
     let mut twin = BTreeMap::new();
+    let mut zone = BTreeMap::new();
     let mut checked_twin = false;
+    let mut checked_zone = false;
     for (i, file) in files.iter().enumerate() {
         let Some(messages) = python_messages(file) else {
             return;
@@ -195,7 +199,12 @@ fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_
             );
             assert_eq!(as_set(&snapshot["health"], "/health/"), health);
             assert_eq!(as_set(&snapshot["twin"], "/twin/"), twin);
+            assert_eq!(
+                as_set(&snapshot["velocity_flags"], "/velocity_flags/"),
+                zone
+            );
             checked_twin |= !twin.is_empty();
+            checked_zone |= !zone.is_empty();
             for m in &messages {
                 assert!(
                     m["log_time"].as_u64().unwrap() >= start,
@@ -208,7 +217,7 @@ fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_
         }
         for m in &messages {
             let topic = m["topic"].as_str().unwrap();
-            let family = ["/flags/", "/health/", "/twin/"]
+            let family = ["/flags/", "/health/", "/twin/", "/velocity_flags/"]
                 .into_iter()
                 .find(|f| topic.starts_with(f));
             if let Some(family) = family {
@@ -216,7 +225,8 @@ fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_
                 let set = match family {
                     "/flags/" => &mut flags,
                     "/health/" => &mut health,
-                    _ => &mut twin,
+                    "/twin/" => &mut twin,
+                    _ => &mut zone,
                 };
                 latest(set, &key, &m["json"]);
             }
@@ -225,6 +235,10 @@ fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_
     assert!(
         checked_twin,
         "no twin fit before a rotation: nothing checked"
+    );
+    assert!(
+        checked_zone,
+        "no ISO zone flag change before a rotation: nothing checked"
     );
     assert!(
         !flags.is_empty(),

@@ -284,6 +284,8 @@ pub struct StateSnapshot {
     pub flags: Vec<FlagMessage>,
     pub health: Vec<HealthMessage>,
     pub twin: Vec<TwinMessage>,
+    /// The last change of each channel's ISO velocity zone flag.
+    pub velocity_flags: Vec<VelocityFlagMessage>,
 }
 
 impl StateSnapshot {

@@ -15,7 +15,7 @@ import sys
 
 from mcap.reader import make_reader
 
-DECODED = ("/log", "/state", "/twin/", "/flags/", "/health/")
+DECODED = ("/log", "/state", "/twin/", "/flags/", "/health/", "/velocity_flags/")
 
 
 def main():

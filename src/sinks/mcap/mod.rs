@@ -20,7 +20,9 @@ pub use writer::{enforce_budget, LogStats, LoggerConfig, McapLogger, RetentionRe
 use crate::config::Config;
 use crate::mcap_log::schema::{LogLevel, StateSnapshot};
 use crate::mcap_log::McapLogError;
-use crate::messages::{FlagMessage, HealthMessage, PipelineMessage, TwinMessage};
+use crate::messages::{
+    FlagMessage, HealthMessage, PipelineMessage, TwinMessage, VelocityFlagMessage,
+};
 use crate::pipeline::{Sink, SinkError};
 use std::collections::{BTreeMap, HashMap};
 use std::path::{Path, PathBuf};
@@ -70,12 +72,13 @@ struct Pause {
 }
 
 /// The current state per channel (last flag change per fault, last health per kind, last
-/// twin fit), which begins every file opened by rotation.
+/// twin fit, last ISO zone flag change), which begins every file opened by rotation.
 #[derive(Default)]
 struct CurrentState {
     flags: BTreeMap<String, FlagMessage>,
     health: BTreeMap<String, HealthMessage>,
     twin: BTreeMap<String, TwinMessage>,
+    velocity_flags: BTreeMap<String, VelocityFlagMessage>,
 }
 
 impl CurrentState {
@@ -92,6 +95,9 @@ impl CurrentState {
             PipelineMessage::Twin(m) => {
                 self.twin.insert(m.channel.to_string(), m.clone());
             }
+            PipelineMessage::VelocityFlag(m) => {
+                self.velocity_flags.insert(m.channel.to_string(), m.clone());
+            }
             _ => {}
         }
     }
@@ -101,6 +107,7 @@ impl CurrentState {
             flags: self.flags.values().cloned().collect(),
             health: self.health.values().cloned().collect(),
             twin: self.twin.values().cloned().collect(),
+            velocity_flags: self.velocity_flags.values().cloned().collect(),
         }
     }
 }
