@@ -9,11 +9,9 @@
 //!   machines and other faults' stray lines reach in the simulator sweep and the dev data.
 //!   Those lines lift several combs at once (a cluttered spectrum scores 2–4 for two or three
 //!   faults), so a weaker comb is also *detected* when it stands alone: score ≥
-//!   `lone_fault_score`, significant at the square of the false-alarm rate (a weaker comb needs
-//!   stronger proof that it is not noise), every harmonic but one standing clear of the floor,
-//!   and separated from the others once it is explained away: either ≥ `lone_score_ratio` ×
-//!   each of them, or none of them significant at all (the margin in calibrated units: what is
-//!   left is what noise gives, whatever its score).
+//!   `lone_fault_score`, ≥ `lone_score_ratio` × every other hypothesis once it is explained away,
+//!   significant at the square of the false-alarm rate (a weaker comb needs stronger proof
+//!   that it is not noise), and every harmonic but one standing clear of the floor.
 //!
 //! The strongest hypothesis leads; the others are re-scored with its comb explained away. A
 //! leader is named when it is detected and no other hypothesis is detected on the evidence the
@@ -114,11 +112,11 @@ impl DecisionRule {
     }
 
     /// Large enough to name when it stands alone (`runner_up`: the strongest other hypothesis
-    /// once this one is explained away, 1 for none; `others_quiet`: none of them significant).
-    fn detected_alone(&self, score: &FaultScore, runner_up: f64, others_quiet: bool) -> bool {
+    /// once this one is explained away, 1 for none).
+    fn detected_alone(&self, score: &FaultScore, runner_up: f64) -> bool {
         self.strongly_significant(score)
             && score.score >= self.lone_fault_score
-            && (others_quiet || score.score >= self.lone_score_ratio * runner_up.max(1.0))
+            && score.score >= self.lone_score_ratio * runner_up.max(1.0)
             && score.harmonics_stand(LONE_HARMONIC_RATIO)
     }
 }
@@ -144,9 +142,6 @@ pub struct Contest<'a> {
     pub leader: &'a FaultScore,
     /// `None` when there is no other hypothesis.
     pub runner_up: Option<&'a FaultScore>,
-    /// The highest significance (decades) of the others once the leader is explained away (0
-    /// for none).
-    pub others_significance: f64,
 }
 
 impl<'a> Contest<'a> {
@@ -158,14 +153,11 @@ impl<'a> Contest<'a> {
         rule: &DecisionRule,
     ) -> Option<Self> {
         let leader = leader(scores, rule)?;
-        let others = || explained.iter().filter(|s| s.fault != leader.fault);
-        let runner_up = others().max_by(|a, b| a.score.total_cmp(&b.score));
-        let others_significance = others().map(|s| s.significance).fold(0.0, f64::max);
-        Some(Contest {
-            leader,
-            runner_up,
-            others_significance,
-        })
+        let runner_up = explained
+            .iter()
+            .filter(|s| s.fault != leader.fault)
+            .max_by(|a, b| a.score.total_cmp(&b.score));
+        Some(Contest { leader, runner_up })
     }
 
     /// The leader, when it is significant and separable from every other significant
@@ -183,17 +175,11 @@ impl<'a> Contest<'a> {
     pub fn named(&self, rule: &DecisionRule) -> Option<Named> {
         if rule.detected(self.leader) && self.separated(rule) {
             Some(Named::BySize)
-        } else if rule.detected_alone(self.leader, self.runner_up_score(), self.others_quiet(rule))
-        {
+        } else if rule.detected_alone(self.leader, self.runner_up_score()) {
             Some(Named::Alone)
         } else {
             None
         }
-    }
-
-    /// Whether none of the others is significant once the leader is explained away.
-    fn others_quiet(&self, rule: &DecisionRule) -> bool {
-        self.others_significance < rule.min_significance()
     }
 
     fn runner_up_score(&self) -> f64 {
@@ -291,14 +277,9 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
         .min(significance_evidence)
         .min(separation_evidence);
     let alone_ratio = best.score / runner_score.max(1.0);
-    let quiet_evidence = (min_sig - contest.others_significance) * std::f64::consts::LN_10;
     let alone = (best.score.max(1e-9) / rule.lone_fault_score)
         .ln()
-        .min(
-            (alone_ratio / rule.lone_score_ratio)
-                .ln()
-                .max(quiet_evidence),
-        )
+        .min((alone_ratio / rule.lone_score_ratio).ln())
         .min((best.significance - 2.0 * min_sig) * std::f64::consts::LN_10);
     // Either way of naming suffices: the evidence is the better of the two.
     let evidence = by_size.max(alone);
@@ -322,28 +303,18 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
             }
         }
         Some(Named::Alone) => {
-            let separation = if contest.others_quiet(rule) {
-                format!(
-                    "nothing else significant once it is explained (the most: 10^-{:.1}, needs \
-                     p ≤ {:.0e}; runner-up {runner_text})",
-                    contest.others_significance, rule.false_alarm_rate
-                )
-            } else {
-                format!(
-                    "{alone_ratio:.1}× the runner-up {runner_text} (needs {:.1}×)",
-                    rule.lone_score_ratio
-                )
-            };
             return Diagnosis {
                 verdict: best.fault.into(),
                 confidence,
                 candidates: Vec::new(),
                 reason: format!(
-                    "{header} stands alone: ≥ {:.1}, {separation}, p ≤ {:.0e}",
+                    "{header} stands alone: ≥ {:.1}, {alone_ratio:.1}× the runner-up {runner_text} \
+                     (needs {:.1}×), p ≤ {:.0e}",
                     rule.lone_fault_score,
+                    rule.lone_score_ratio,
                     rule.false_alarm_rate * rule.false_alarm_rate
                 ),
-            };
+            }
         }
         None => {}
     }
@@ -352,14 +323,9 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
             format!("not significant (needs p ≤ {:.0e})", rule.false_alarm_rate)
         } else {
             format!(
-                "below {:.1} and not alone ({alone_ratio:.1}× the runner-up, others up to \
-                 10^-{:.1}; alone needs ≥ {:.1}, p ≤ {:.0e}, and {:.1}× or nothing else \
-                 significant)",
-                rule.min_fault_score,
-                contest.others_significance,
-                rule.lone_fault_score,
-                rule.false_alarm_rate * rule.false_alarm_rate,
-                rule.lone_score_ratio
+                "below {:.1} and not alone ({alone_ratio:.1}× the runner-up; alone needs ≥ {:.1} \
+                 and {:.1}×)",
+                rule.min_fault_score, rule.lone_fault_score, rule.lone_score_ratio
             )
         };
         (Vec::new(), format!("{header} is {what}"))
@@ -439,25 +405,6 @@ mod tests {
         assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
         // Below the lone floor: no.
         let d = verdict([(1.0, 0.0), (2.4, 30.0), (1.0, 0.0), (1.0, 0.0)]);
-        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
-    }
-
-    #[test]
-    fn a_lone_comb_is_separated_when_nothing_else_is_significant_whatever_its_score() {
-        // Only 1.2× the next score, but the next is what noise gives (p = 10^-1.5): named.
-        let d = verdict([(3.1, 1.5), (3.7, 9.5), (3.1, 2.1), (2.5, 1.2)]);
-        assert_eq!(d.verdict, Verdict::InnerRace, "{}", d.reason);
-        assert!(
-            d.reason.contains("nothing else significant"),
-            "{}",
-            d.reason
-        );
-        assert!(d.confidence > 0.5);
-        // The same scores with the next comb significant (p = 10^-3.6): a close call, none.
-        let d = verdict([(3.1, 3.6), (3.7, 9.5), (3.1, 2.1), (2.5, 1.2)]);
-        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
-        // Nothing else significant, but the leader itself only at p = 10^-5 (> 10^-6): none.
-        let d = verdict([(3.1, 1.5), (3.7, 5.0), (3.1, 2.1), (2.5, 1.2)]);
         assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
     }
 

@@ -39,14 +39,13 @@ pub fn render_text(r: &AnalyzeReport) -> String {
     );
     let _ = writeln!(
         out,
-        "  fault scores (comb peak/floor over {} harmonics and their sidebands, ±{:.0} % slip; a fault needs p ≤ {:.0e} against noise, ≥ {:.1}, and {:.1}× any other detected fault once explained; or, alone, ≥ {:.1} at p ≤ {:.0e} and {:.1}× every other or nothing else significant):",
+        "  fault scores (comb peak/floor over {} harmonics and their sidebands, ±{:.0} % slip; a fault needs p ≤ {:.0e} against noise, ≥ {:.1}, and {:.1}× any other detected fault once explained; or, alone, ≥ {:.1} and {:.1}× every other):",
         r.thresholds.harmonics,
         r.thresholds.fault_tolerance * 100.0,
         r.thresholds.false_alarm_rate,
         r.thresholds.min_fault_score,
         r.thresholds.min_score_ratio,
         r.thresholds.lone_fault_score,
-        r.thresholds.false_alarm_rate * r.thresholds.false_alarm_rate,
         r.thresholds.lone_score_ratio
     );
     for h in &r.hypotheses {
