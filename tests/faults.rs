@@ -494,44 +494,6 @@ fn kill_9_at_20_random_moments_loses_at_most_the_last_unflushed_second() {
 }
 
 #[test]
-fn retention_says_which_files_it_deleted() {
-    let dir = scratch_dir("faults-retention");
-    let data = dir.join("data");
-    let root = format!("/dev/shm/bearingd-faults-rt-{}", std::process::id());
-    let config = config_file(&dir, |text| {
-        text.replace("mcap_max_file_mb = 256", "mcap_max_file_mb = 1")
-            .replace("mcap_disk_budget_mb = 4096", "mcap_disk_budget_mb = 2")
-            .replace("\"/run/bearingd/iceoryx2\"", &format!("\"{root}\""))
-    });
-    let out = bearingd(&[
-        "run",
-        "--config",
-        config.to_str().unwrap(),
-        "--data-dir",
-        data.to_str().unwrap(),
-        "--fast",
-        "--quiet",
-        "--duration",
-        "120",
-    ]);
-    let _ = std::fs::remove_dir_all(&root);
-    let stderr = stderr_of(&out);
-    assert!(out.status.success(), "{stderr}");
-    let deleted: Vec<&str> = stderr
-        .lines()
-        .filter_map(|l| l.strip_prefix("bearingd: retention: deleted "))
-        .flat_map(|l| l.split(" (").next().unwrap().split(", "))
-        .collect();
-    assert!(!deleted.is_empty(), "{stderr}");
-    for path in deleted {
-        assert!(
-            path.contains("bearingd-") && !Path::new(path).exists(),
-            "{path}"
-        );
-    }
-}
-
-#[test]
 fn replay_of_a_file_that_is_not_mcap_exits_2_naming_it() {
     let dir = scratch_dir("faults-replay-junk");
     for (name, bytes) in [

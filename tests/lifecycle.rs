@@ -141,16 +141,18 @@ fn latest(state: &mut BTreeMap<String, Value>, topic: &str, message: &Value) {
     state.insert(format!("{topic} {kind}"), message.clone());
 }
 
-#[test]
-fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_it() {
-    let dir = scratch_dir("lifecycle-rotation");
+/// `bearingd run --fast` of the embedded default with `edit` applied, for `seconds` of signal,
+/// logging under `dir/data` with its own iceoryx2 root (removed after); its output and the
+/// data dir.
+fn fast_run(dir: &Path, seconds: &str, edit: impl Fn(String) -> String) -> (Output, PathBuf) {
     let data = dir.join("data");
-    let root = format!("/dev/shm/bearingd-lifecycle-rot-{}", std::process::id());
-    let config = config_file(&dir, |text| {
-        // Twice the default imbalance: ISO zone C, so the zone flag rises early (state too).
-        text.replace("mcap_max_file_mb = 256", "mcap_max_file_mb = 1")
-            .replace("imbalance_g = 0.05", "imbalance_g = 0.1")
-            .replace("\"/run/bearingd/iceoryx2\"", &format!("\"{root}\""))
+    // The scratch dir's name is unique per test and process.
+    let root = format!(
+        "/dev/shm/{}-iox",
+        dir.file_name().unwrap().to_string_lossy()
+    );
+    let config = config_file(dir, |text| {
+        edit(text).replace("\"/run/bearingd/iceoryx2\"", &format!("\"{root}\""))
     });
     let out = bearingd(&[
         "run",
@@ -161,9 +163,20 @@ fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_
         "--fast",
         "--quiet",
         "--duration",
-        "60",
+        seconds,
     ]);
     let _ = std::fs::remove_dir_all(&root);
+    (out, data)
+}
+
+#[test]
+fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_it() {
+    let dir = scratch_dir("lifecycle-rotation");
+    let (out, data) = fast_run(&dir, "60", |text| {
+        // Twice the default imbalance: ISO zone C, so the zone flag rises early (state too).
+        text.replace("mcap_max_file_mb = 256", "mcap_max_file_mb = 1")
+            .replace("imbalance_g = 0.05", "imbalance_g = 0.1")
+    });
     assert!(out.status.success(), "{}", stderr_of(&out));
     let files = mcap_files(&data.join("mcap"));
     assert!(files.len() >= 3, "no rotation: {files:?}");
@@ -249,25 +262,10 @@ fn issue11_a_rotated_file_begins_with_the_current_state_and_nothing_from_before_
 #[test]
 fn issue11_each_retention_deletion_is_a_log_message_in_the_mcap_file() {
     let dir = scratch_dir("lifecycle-retention");
-    let data = dir.join("data");
-    let root = format!("/dev/shm/bearingd-lifecycle-ret-{}", std::process::id());
-    let config = config_file(&dir, |text| {
+    let (out, data) = fast_run(&dir, "120", |text| {
         text.replace("mcap_max_file_mb = 256", "mcap_max_file_mb = 1")
             .replace("mcap_disk_budget_mb = 4096", "mcap_disk_budget_mb = 2")
-            .replace("\"/run/bearingd/iceoryx2\"", &format!("\"{root}\""))
     });
-    let out = bearingd(&[
-        "run",
-        "--config",
-        config.to_str().unwrap(),
-        "--data-dir",
-        data.to_str().unwrap(),
-        "--fast",
-        "--quiet",
-        "--duration",
-        "120",
-    ]);
-    let _ = std::fs::remove_dir_all(&root);
     let stderr = stderr_of(&out);
     assert!(out.status.success(), "{stderr}");
     let deleted: Vec<String> = stderr
@@ -277,6 +275,12 @@ fn issue11_each_retention_deletion_is_a_log_message_in_the_mcap_file() {
         .map(String::from)
         .collect();
     assert!(!deleted.is_empty(), "{stderr}");
+    for path in &deleted {
+        assert!(
+            path.contains("bearingd-") && !Path::new(path).exists(),
+            "said deleted but still there, or not a log: {path}"
+        );
+    }
     let mut noted = Vec::new();
     for file in mcap_files(&data.join("mcap")) {
         let Some(messages) = python_messages(&file) else {
