@@ -132,8 +132,24 @@ enum Command {
 }
 
 /// Parses the command line, runs the command, prints errors, returns the exit code.
+/// A report command whose reader went away (`bearingd analyze ... | head`) ends as any Unix
+/// tool does, by SIGPIPE, instead of panicking in `println!`: Rust ignores SIGPIPE, so a write
+/// to a closed pipe is an error that `println!` turns into a panic. The daemon (`run`) keeps the
+/// error: its stdout may be a journal that restarts, and it must not die of that.
+fn end_quietly_on_a_closed_pipe() {
+    #[allow(unsafe_code)]
+    // SAFETY: setting a signal's disposition to its default is async-signal-safe and is done
+    // before any thread is started.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    if !matches!(cli.command, Command::Run(_)) {
+        end_quietly_on_a_closed_pipe();
+    }
     let result = match cli.command {
         Command::Analyze(args) => analyze::run(&args),
         Command::Run(args) => run::run_command(&args),

@@ -299,3 +299,29 @@ fn a_simulated_record_is_diagnosed_and_the_twin_reported() {
         &["--duration ten"],
     );
 }
+
+#[test]
+fn output_into_a_pipe_closed_early_ends_without_a_panic() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::Stdio;
+    // `bearingd analyze --demo | head -0`: the reader is gone before the first line is written.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(["analyze", "--demo"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run bearingd");
+    drop(child.stdout.take());
+    let out = child.wait_with_output().expect("bearingd ends");
+    let err = stderr(&out);
+    assert!(
+        !err.contains("panicked"),
+        "a closed pipe made a panic: {err}"
+    );
+    assert_eq!(
+        out.status.signal(),
+        Some(libc::SIGPIPE),
+        "expected the end of a Unix tool whose reader left (SIGPIPE), got {:?}: {err}",
+        out.status
+    );
+}
