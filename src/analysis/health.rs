@@ -51,6 +51,23 @@ pub struct Baseline {
     pub aging_rms: RunningStats,
 }
 
+/// The baselines of every channel as JSON (a list of `[channel, baseline]` pairs): what
+/// `baselines.json` holds and what a log's `bearingd.state` record carries.
+pub fn baselines_to_json(
+    baselines: &std::collections::BTreeMap<crate::messages::ChannelId, Baseline>,
+) -> String {
+    let list: Vec<_> = baselines.iter().collect();
+    serde_json::to_string_pretty(&list).unwrap_or_else(|_| "[]".to_string())
+}
+
+/// Reads what [`baselines_to_json`] wrote.
+pub fn baselines_from_json(
+    text: &str,
+) -> Result<std::collections::BTreeMap<crate::messages::ChannelId, Baseline>, serde_json::Error> {
+    serde_json::from_str::<Vec<(crate::messages::ChannelId, Baseline)>>(text)
+        .map(|list| list.into_iter().collect())
+}
+
 /// A stage change.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StageChange {

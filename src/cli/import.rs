@@ -1,14 +1,18 @@
-//! `bearingd import FILE --out DIR`: a recording (.mat, .csv, WAV) as a raw MCAP log, plus the
-//! configuration to replay it with, so that recorded data goes through the daemon's pipeline
-//! (`bearingd replay DIR/*.mcap --config DIR/replay.toml`).
+//! `bearingd import FILE --out DIR`: a recording (.mat, .csv, WAV) as a raw MCAP log that
+//! describes itself as the daemon's logs do (the settings to replay it with, the bearing, the
+//! rate, and a real date: an IMS file's name, else the file's modification time), so that
+//! recorded data goes through the daemon's pipeline with `bearingd replay DIR/*.mcap`. The
+//! same settings are also written as `DIR/replay.toml`, a starting point for `--config`.
 
 use super::{CliError, RecordingArgs};
+use crate::mcap_log::header::IMPORT_RECORD;
 use crate::messages::{ChannelId, PipelineMessage, RawBlock};
 use crate::offline::{resolve_conditions, AnalyzeRequest};
-use crate::recording::read_recording;
+use crate::recording::{read_recording, time_from_name, NamedTimeKind};
+use crate::sinks::mcap::metadata::run_records;
 use crate::sinks::mcap::{LoggerConfig, McapLogger};
 use clap::Args;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct ImportArgs {
@@ -62,8 +66,35 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         sensor: args.sensor.clone(),
         axis: "radial".into(),
     };
-    let mut logger =
-        McapLogger::create(LoggerConfig::new(&args.out), 0).map_err(CliError::input)?;
+    let config_text = format!(
+        "# Replays {file} (bearingd import): bearingd replay {out}/*.mcap (the log carries these \
+         settings; give --config {out}/replay.toml after editing it)\n\
+         [[sensors]]\nid = \"{sensor}\"\ntransport = \"shm\"\nsample_rate_hz = {fs}\nscale_g_per_count = {scale:e}\naxes = [\"radial\"]\nbearing = \"{bearing_spec}\"\n\
+         [sensors.speed]\nsource = \"fixed\"\nrpm = {rpm}\n\n\
+         # A recording is short: choose bands every 3 s and raise flags after 1 s.\n\
+         [analysis]\nband_period_s = 3.0\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 5.0\nbaseline_windows = 5\n\n\
+         [outputs]\nstate_dir = \"{out}/state\"\nmcap_dir = \"{out}/replay\"\n",
+        out = args.out.display(),
+        sensor = args.sensor,
+    );
+    let config_path = args.out.join("replay.toml");
+    let config = crate::config::parse(&config_text, &config_path.display().to_string())
+        .map_err(|e| CliError::input(format!("the settings import made are refused: {e}")))?;
+    let (origin_ns, time_source) = recording_date(&args.file);
+    let mut metadata = run_records(&config, origin_ns, origin_ns, &Default::default());
+    metadata.push((
+        IMPORT_RECORD.to_string(),
+        [
+            ("source".to_string(), args.file.display().to_string()),
+            ("time_source".to_string(), time_source.to_string()),
+        ]
+        .into(),
+    ));
+    let logger_config = LoggerConfig {
+        metadata,
+        ..LoggerConfig::new(&args.out)
+    };
+    let mut logger = McapLogger::create(logger_config, origin_ns).map_err(CliError::input)?;
     let block = ((fs * BLOCK_S).round() as usize).max(1);
     for (i, chunk) in recording.samples.chunks(block).enumerate() {
         let first_sample = (i * block) as u64;
@@ -74,34 +105,47 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
             scale_g_per_count: scale,
             counts: chunk.iter().map(|x| (x / scale).round() as i32).collect(),
         });
-        let time = (first_sample as f64 / fs * 1e9) as u64;
+        let time = origin_ns + (first_sample as f64 / fs * 1e9) as u64;
         logger
             .log(&message, time, time)
             .map_err(CliError::failure)?;
     }
     let path = logger.current_path().map(|p| p.to_path_buf());
     logger.finish().map_err(CliError::failure)?;
-    let config = format!(
-        "# Replays {file} (bearingd import): bearingd replay {out}/*.mcap --config {out}/replay.toml\n\
-         [[sensors]]\nid = \"{sensor}\"\ntransport = \"shm\"\nsample_rate_hz = {fs}\nscale_g_per_count = {scale:e}\naxes = [\"radial\"]\nbearing = \"{bearing_spec}\"\n\
-         [sensors.speed]\nsource = \"fixed\"\nrpm = {rpm}\n\n\
-         # A recording is short: choose bands every 3 s and raise flags after 1 s.\n\
-         [analysis]\nband_period_s = 3.0\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 5.0\nbaseline_windows = 5\n\n\
-         [outputs]\nstate_dir = \"{out}/state\"\nmcap_dir = \"{out}/replay\"\n",
-        out = args.out.display(),
-        sensor = args.sensor,
-    );
-    let config_path = args.out.join("replay.toml");
-    std::fs::write(&config_path, config)
+    std::fs::write(&config_path, config_text)
         .map_err(|e| CliError::failure(format!("{}: cannot write: {e}", config_path.display())))?;
     println!(
-        "imported {} samples ({:.2} s at {fs} Hz, {:.3e} g per count) into {}; replay with: bearingd replay {} --config {}",
+        "imported {} samples ({:.2} s at {fs} Hz, {:.3e} g per count, dated {} from the {time_source}) into {}; replay with: bearingd replay {} (its settings are also in {})",
         recording.samples.len(),
         recording.samples.len() as f64 / fs,
         scale,
+        crate::mcap_log::files::utc_text(origin_ns),
         path.as_ref().map_or("?".into(), |p| p.display().to_string()),
         path.as_ref().map_or("?".into(), |p| p.display().to_string()),
         config_path.display()
     );
     Ok(())
+}
+
+/// When the recording began, ns since the Unix epoch, and where that came from: the date an IMS
+/// file's name states, else the file's modification time (the best a .mat or CSV file says),
+/// else the epoch.
+fn recording_date(file: &Path) -> (u64, &'static str) {
+    if let Some(named) = time_from_name(file).filter(|t| t.kind == NamedTimeKind::ImsDate) {
+        return (
+            (named.seconds.max(0.0) * 1e9) as u64,
+            "file name (IMS date)",
+        );
+    }
+    let modified = std::fs::metadata(file)
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+    match modified {
+        Some(since_epoch) => (since_epoch.as_nanos() as u64, "file modification time"),
+        None => (
+            0,
+            "nothing (no date in the name, no modification time): the Unix epoch",
+        ),
+    }
 }

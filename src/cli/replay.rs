@@ -10,7 +10,7 @@ use super::CliError;
 use crate::config::{self, Config};
 use crate::daemon::events::{DaemonEvent, Events};
 use crate::daemon::lock::DirLock;
-use crate::daemon::{replay, ReplayOptions, ReplaySummary, RunStart};
+use crate::daemon::{replay, BaselinesFrom, ReplayOptions, ReplaySummary, RunStart};
 use crate::mcap_log::files::utc_text;
 use crate::pipeline::{Sink, SinkError};
 use crate::sinks::mcap::McapSink;
@@ -91,16 +91,17 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::input(format!("{}: cannot create: {e}", args.out.display())))?;
     let _lock = DirLock::acquire(&args.out).map_err(CliError::input)?;
-    let mut open_sinks = |run: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {
-        let run_id = run.run_id.unwrap_or(run.origin_ns);
-        let (sink, _) =
-            McapSink::for_run(&config, run.origin_ns, run_id).map_err(|e| SinkError {
-                sink: "MCAP log",
-                count: 1,
-                first: Box::new(e),
-            })?;
-        Ok(vec![Box::new(sink)])
-    };
+    let mut open_sinks =
+        |run: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {
+            let run_id = run.run_id.unwrap_or(run.origin_ns);
+            let (sink, _) = McapSink::for_run(&config, run.origin_ns, run_id, &run.baselines)
+                .map_err(|e| SinkError {
+                    sink: "MCAP log",
+                    count: 1,
+                    first: Box::new(e),
+                })?;
+            Ok(vec![Box::new(sink)])
+        };
     let bar = progress_bar(args, plan.bytes());
     let options = ReplayOptions {
         speed: args.speed,
@@ -251,6 +252,7 @@ fn print_json(
                 "origin_ns": r.origin_ns,
                 "origin_utc": utc_text(r.origin_ns),
                 "first_file": r.first_file,
+                "baselines_from": r.baselines_from,
             })
         })
         .collect();
@@ -301,9 +303,19 @@ fn print_text(summary: &ReplaySummary, out: &Path) {
 fn report_boundaries_and_losses(summary: &ReplaySummary, plan: &ReplayPlan) {
     for pair in summary.runs.windows(2) {
         let (before, after) = (&pair[0], &pair[1]);
+        let baselines = match after.baselines_from {
+            BaselinesFrom::Log => format!(
+                "from the {} channel baseline(s) the daemon loaded then (the log's record)",
+                after.baselines.len()
+            ),
+            BaselinesFrom::PreviousRun => "from the baselines the run before reached (the log \
+                                           does not record what the daemon loaded)"
+                .to_string(),
+            BaselinesFrom::None => "learning its baselines from scratch".to_string(),
+        };
         eprintln!(
             "bearingd: replay: run boundary at {}: run {} (sample 0 at {}) follows run {}: the \
-             daemon restarted (a crash or a stop); the pipeline starts again",
+             daemon restarted (a crash or a stop); the pipeline starts again, {baselines}",
             after.first_file.display(),
             after
                 .run_id

@@ -163,6 +163,7 @@ pub(crate) struct RawOutputs {
     pub mcap_dir: Field<String>,
     pub mcap_max_file_mb: Field<i64>,
     pub mcap_max_file_s: Field<f64>,
+    pub mcap_fsync_interval_s: Field<f64>,
     pub mcap_disk_budget_mb: Field<i64>,
     pub alerts_service: Field<String>,
     pub iceoryx2_root: Field<String>,

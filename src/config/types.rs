@@ -276,6 +276,10 @@ pub struct OutputConfig {
     pub mcap_max_file_mb: u64,
     /// ...or at this age, in seconds.
     pub mcap_max_file_s: f64,
+    /// Seconds of data between two forced writes (fsync) of the open MCAP file to the disk:
+    /// what a power cut can lose. 0 forces every flush (every second of data).
+    #[serde(default = "default_fsync_interval_s")]
+    pub mcap_fsync_interval_s: f64,
     /// Disk space MCAP files may use before the oldest are deleted, in MiB; at least twice
     /// `mcap_max_file_mb` (one open file plus one finished).
     pub mcap_disk_budget_mb: u64,
@@ -302,6 +306,11 @@ impl OutputConfig {
     }
 }
 
+/// Logs from before `mcap_fsync_interval_s` read as the default.
+fn default_fsync_interval_s() -> f64 {
+    5.0
+}
+
 impl Default for OutputConfig {
     fn default() -> Self {
         OutputConfig {
@@ -309,6 +318,7 @@ impl Default for OutputConfig {
             mcap_dir: PathBuf::from("/var/log/bearingd"),
             mcap_max_file_mb: 256,
             mcap_max_file_s: 3600.0,
+            mcap_fsync_interval_s: default_fsync_interval_s(),
             mcap_disk_budget_mb: 4096,
             alerts_service: "bearingd/alerts".to_string(),
             iceoryx2_root: PathBuf::from("/run/bearingd/iceoryx2"),

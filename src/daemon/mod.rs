@@ -15,5 +15,5 @@ pub mod run;
 pub mod state;
 
 pub use events::{ignore_events, DaemonEvent, Events};
-pub use replay::{replay, Gap, ReplayError, ReplayOptions, ReplaySummary, RunStart};
+pub use replay::{replay, BaselinesFrom, Gap, ReplayError, ReplayOptions, ReplaySummary, RunStart};
 pub use run::{run, RunError, RunOptions, RunSummary};

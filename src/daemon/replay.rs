@@ -3,10 +3,10 @@
 //!
 //! - A run boundary (another run id: the daemon stopped or crashed and started again) starts
 //!   a new pipeline and new sinks, as the restarted daemon did: its sample time starts again
-//!   at 0, and its output log is dated with its own wall-clock origin. The new pipeline keeps
-//!   the health baselines the previous run reached, standing in for the `baselines.json` the
-//!   restarted daemon loaded (the log does not record that file; it was saved at most
-//!   `state_save_interval_s` before the crash).
+//!   at 0, and its output log is dated with its own wall-clock origin. Every run's pipeline
+//!   starts from the health baselines the daemon loaded at that start (the log's
+//!   `bearingd.state` record); a log without that record (an older bearingd) starts from the
+//!   baselines the previous run reached, the nearest stand-in, and the summary says which.
 //! - A gap inside a run (a channel's next raw block starts after where the last one ended:
 //!   frames lost live, a damaged chunk, a missing file) is reported with its length and does
 //!   not reset anything: the channel's windows restart after it, exactly as the live pipeline
@@ -18,6 +18,7 @@
 //! not influence flags, so the flags of a replay equal the live run's at the same samples.
 
 use super::events::{DaemonEvent, Events};
+use crate::analysis::health::{baselines_from_json, Baseline};
 use crate::config::Config;
 use crate::mcap_log::ReadSummary;
 use crate::messages::{ChannelId, FlagMessage, PipelineMessage};
@@ -38,7 +39,7 @@ pub struct ReplayOptions {
 }
 
 /// Where a run of the replay starts, for whoever opens its sinks.
-#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct RunStart {
     /// The original run's id; `None` for files without metadata.
     pub run_id: Option<u64>,
@@ -47,6 +48,41 @@ pub struct RunStart {
     pub origin_ns: u64,
     /// The run's first file.
     pub first_file: PathBuf,
+    /// Where the health baselines the run starts with came from.
+    pub baselines_from: BaselinesFrom,
+    /// Those baselines (the replay's own log records them, as the daemon's did).
+    #[serde(skip)]
+    pub baselines: BTreeMap<ChannelId, Baseline>,
+}
+
+/// Where a replayed run's starting health baselines came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BaselinesFrom {
+    /// The run's `bearingd.state` record: what the daemon loaded at that start.
+    Log,
+    /// The log has no such record: those the previous run of the replay reached.
+    PreviousRun,
+    /// No record and no run before: learned from scratch.
+    None,
+}
+
+impl BaselinesFrom {
+    /// The start of `run`, after the runs before it reached `reached` (`None` for the first).
+    fn choose(
+        run: &PlannedRun,
+        reached: Option<&BTreeMap<ChannelId, Baseline>>,
+    ) -> (BaselinesFrom, BTreeMap<ChannelId, Baseline>) {
+        let logged = run
+            .start_baselines_json
+            .as_deref()
+            .and_then(|json| baselines_from_json(json).ok());
+        match (logged, reached) {
+            (Some(logged), _) => (BaselinesFrom::Log, logged),
+            (None, Some(reached)) => (BaselinesFrom::PreviousRun, reached.clone()),
+            (None, None) => (BaselinesFrom::None, BTreeMap::new()),
+        }
+    }
 }
 
 /// Gives the sinks of a run, once its time origin is known.
@@ -120,11 +156,12 @@ pub fn replay(
         bytes_before: 0,
         bytes_total: plan.bytes(),
     };
-    let mut baselines = BTreeMap::new();
+    let mut reached: Option<BTreeMap<ChannelId, Baseline>> = None;
     for run in &plan.runs {
-        let mut replayed = RunReplay::new(run, plan, config, &baselines, options);
+        let start = BaselinesFrom::choose(run, reached.as_ref());
+        let mut replayed = RunReplay::new(run, plan, config, start, options);
         let result = replayed.go(open_sinks, &mut summary, &mut progress, events);
-        baselines = replayed.pipeline.baselines();
+        reached = Some(replayed.pipeline.baselines());
         let counters = replayed.source.counters().clone();
         progress.bytes_before += counters.bytes_read;
         summary.raw_blocks += counters.raw_blocks;
@@ -164,6 +201,8 @@ struct RunReplay<'a> {
     next_sample: HashMap<ChannelId, u64>,
     rates: HashMap<String, f64>,
     first_file: PathBuf,
+    baselines_from: BaselinesFrom,
+    start_baselines: BTreeMap<ChannelId, Baseline>,
 }
 
 impl<'a> RunReplay<'a> {
@@ -171,10 +210,10 @@ impl<'a> RunReplay<'a> {
         run: &'a PlannedRun,
         plan: &ReplayPlan,
         config: &Config,
-        baselines: &BTreeMap<ChannelId, crate::analysis::health::Baseline>,
+        (baselines_from, start_baselines): (BaselinesFrom, BTreeMap<ChannelId, Baseline>),
         options: &ReplayOptions,
     ) -> Self {
-        let pipeline = Pipeline::new(config, baselines);
+        let pipeline = Pipeline::new(config, &start_baselines);
         let paths = plan.paths(run);
         let source = ReplaySource::open(
             &paths,
@@ -191,6 +230,8 @@ impl<'a> RunReplay<'a> {
             next_sample: HashMap::new(),
             rates: config.sample_rates(),
             first_file: paths.first().cloned().unwrap_or_default(),
+            baselines_from,
+            start_baselines,
         }
     }
 
@@ -259,6 +300,8 @@ impl<'a> RunReplay<'a> {
                 .or(self.source.counters().first_block_origin_ns)
                 .unwrap_or(0),
             first_file: self.first_file.clone(),
+            baselines_from: self.baselines_from,
+            baselines: self.start_baselines.clone(),
         };
         self.sinks = Some(open_sinks(&start)?);
         summary.runs.push(start);

@@ -34,10 +34,11 @@
 use super::events::{DaemonEvent, Events};
 use super::lock::{DirLock, LockError};
 use super::state::{load_baselines, save_baselines};
+use crate::analysis::health::Baseline;
 use crate::clock::wall_clock_now_ns;
 use crate::config::{Config, Transport};
 use crate::mcap_log::McapLogError;
-use crate::messages::{FlagMessage, PipelineMessage, TwinMessage};
+use crate::messages::{ChannelId, FlagMessage, PipelineMessage, TwinMessage};
 use crate::pipeline::twin_queue::{twin_requests, TwinRequestQueue, TwinRequests};
 use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinWorker};
 use crate::sinks::alerts::PublisherSummary;
@@ -47,6 +48,7 @@ use crate::sinks::systemd::{keep_alive, status_text, Notifier};
 use crate::sources::live::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
 use crate::sources::sim::SimSource;
 use crate::sources::Arrived;
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::mpsc;
 use std::time::Duration;
@@ -135,17 +137,18 @@ pub async fn run(
     let can_sources = open_can_sources(&config)?;
     // Wall time of sample 0: the log's time base, and the fleet bridge's.
     let origin_ns = wall_clock_now_ns();
-    sinks.push(Box::new(open_log(&config, origin_ns, &events)?));
-    if let Some(fleet) = start_fleet(&config, origin_ns, &events)? {
-        sinks.push(Box::new(fleet));
-    }
-    let alerts = start_alerts(&config, &events)?;
+    // The learned state before the log, which records what the run started with.
     let (baselines, loaded) = load_baselines(&state_dir);
     match loaded {
         Ok(Some(loaded)) => events(DaemonEvent::StateLoaded(loaded)),
         Ok(None) => events(DaemonEvent::NoState(state_dir.clone())),
         Err(problem) => events(DaemonEvent::State(problem)),
     }
+    sinks.push(Box::new(open_log(&config, origin_ns, &baselines, &events)?));
+    if let Some(fleet) = start_fleet(&config, origin_ns, &events)? {
+        sinks.push(Box::new(fleet));
+    }
+    let alerts = start_alerts(&config, &events)?;
     let pipeline = Pipeline::new(&config, &baselines);
 
     let (input_tx, input_rx) = async_mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
@@ -260,9 +263,15 @@ fn lock_data_dirs(config: &Config, events: &Events) -> Result<Vec<DirLock>, RunE
     Ok(locks)
 }
 
-/// Recovers what a crash left in the log directory and opens the log, sample 0 at now.
-fn open_log(config: &Config, origin_ns: u64, events: &Events) -> Result<McapSink, RunError> {
-    let (log, recovered) = McapSink::for_config(config, origin_ns)?;
+/// Recovers what a crash left in the log directory and opens the log, sample 0 at now, the
+/// run starting with `baselines`.
+fn open_log(
+    config: &Config,
+    origin_ns: u64,
+    baselines: &BTreeMap<ChannelId, Baseline>,
+    events: &Events,
+) -> Result<McapSink, RunError> {
+    let (log, recovered) = McapSink::for_config(config, origin_ns, baselines)?;
     let log = {
         let events = events.clone();
         log.on_notice(move |notice| events(DaemonEvent::Log(notice.clone())))

@@ -6,7 +6,7 @@
 //! directory): a `kill -9` or a power cut finds either the previous save or the new one, never
 //! half a file, and loses at most one period of learning.
 
-use crate::analysis::health::Baseline;
+use crate::analysis::health::{baselines_from_json, baselines_to_json, Baseline};
 use crate::messages::ChannelId;
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -52,14 +52,14 @@ pub fn load_baselines(
         .ok()
         .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
         .map_or(0, |d| u64::try_from(d.as_nanos()).unwrap_or(u64::MAX));
-    match serde_json::from_str::<Vec<(ChannelId, Baseline)>>(&text) {
-        Ok(list) => {
+    match baselines_from_json(&text) {
+        Ok(baselines) => {
             let loaded = StateLoaded {
                 path,
-                channels: list.len(),
+                channels: baselines.len(),
                 saved_at_ns,
             };
-            (list.into_iter().collect(), Ok(Some(loaded)))
+            (baselines, Ok(Some(loaded)))
         }
         Err(e) => (
             BTreeMap::new(),
@@ -78,9 +78,8 @@ pub fn save_baselines(
 ) -> Result<(), StateError> {
     let path = state_dir.join(BASELINES_FILE);
     let temporary = state_dir.join(format!("{BASELINES_FILE}.new"));
-    let list: Vec<_> = baselines.iter().collect();
     let write = || -> std::io::Result<()> {
-        let text = serde_json::to_string_pretty(&list).map_err(std::io::Error::other)?;
+        let text = baselines_to_json(baselines);
         let mut file = std::fs::File::create(&temporary)?;
         file.write_all(text.as_bytes())?;
         file.sync_all()?;

@@ -4,7 +4,7 @@
 //! boundaries, and to analyse with the settings the log was recorded with, not today's.
 //!
 //! Reading stops at the first message, so a header costs at most one chunk; a file without
-//! these records (an older bearingd, `bearingd import`) gives an empty header, not an error.
+//! these records (an older bearingd) gives an empty header, not an error.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -20,6 +20,12 @@ pub const CONFIG_RECORD: &str = "bearingd.config";
 pub const CHANNEL_RECORD: &str = "bearingd.channel";
 /// The file's place in its run (`sequence`, from 1).
 pub const FILE_RECORD: &str = "bearingd.file";
+/// The learned state the run started with (`baselines_json`: the health baselines the daemon
+/// loaded from `baselines.json`), so that a replay starts each run from the same state.
+pub const STATE_RECORD: &str = "bearingd.state";
+/// A log made by `bearingd import`: the recording it came from (`source`) and where its date
+/// came from (`time_source`).
+pub const IMPORT_RECORD: &str = "bearingd.import";
 
 /// What one file's metadata records say (each `None` when absent or unparsable).
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -37,6 +43,8 @@ pub struct LogHeader {
     pub config_json: Option<String>,
     /// The bearingd version that wrote it.
     pub version: Option<String>,
+    /// The health baselines the run started with, as JSON (`bearingd.state`).
+    pub start_baselines_json: Option<String>,
 }
 
 impl LogHeader {
@@ -75,6 +83,7 @@ impl LogHeader {
             }
             CONFIG_RECORD => self.config_json = pairs.get("json").cloned(),
             FILE_RECORD => self.sequence = number("sequence"),
+            STATE_RECORD => self.start_baselines_json = pairs.get("baselines_json").cloned(),
             _ => {}
         }
     }

@@ -368,7 +368,7 @@ iceoryx2_root = "{iox}"
     let _ = std::fs::remove_dir_all(&iox_root);
 }
 
-/// `bearingd import` of every CWRU record, then `bearingd replay` with the config it writes:
+/// `bearingd import` of every CWRU record, then `bearingd replay` with the settings its log carries:
 /// the diagnosable records (inner and outer race, 0.007 and 0.021 in) raise their fault's flag
 /// and no other; no record raises a flag of a wrong fault.
 #[test]
@@ -395,8 +395,6 @@ fn imported_cwru_records_replayed_raise_the_right_flags() {
         let replayed = bearingd(&[
             "replay",
             log[0].to_str().unwrap(),
-            "--config",
-            out.join("replay.toml").to_str().unwrap(),
             "--quiet",
             "--json",
             "--out",
@@ -408,6 +406,8 @@ fn imported_cwru_records_replayed_raise_the_right_flags() {
             String::from_utf8_lossy(&replayed.stderr)
         );
         let summary: serde_json::Value = serde_json::from_slice(&replayed.stdout).unwrap();
+        // The imported log carries the settings it is replayed with.
+        assert_eq!(summary["settings_from"], "log", "{summary}");
         let raised: Vec<String> = summary["flags"]
             .as_array()
             .unwrap()

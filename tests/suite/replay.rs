@@ -305,14 +305,17 @@ fn replay_of_logs_with_different_settings_exits_2_naming_them_unless_config_is_g
     assert_eq!(summary["config_differences"].as_array().unwrap().len(), 1);
 }
 
+/// `bearingd import` writes a log that describes itself as the daemon's do: replay needs no
+/// `--config`, finds the same flags as with the settings file import also writes, and the log
+/// is dated by the recording (here the CSV's modification time), not 1970.
 #[test]
-fn replay_of_a_log_without_metadata_says_it_falls_back_to_the_embedded_default() {
+fn an_imported_recording_carries_its_settings_and_date_and_replays_without_a_config() {
     let dir = scratch_dir("replay-import");
     let csv = dir.join("record.csv");
     let simulated = bearingd(&[
         "simulate",
         "--duration",
-        "2",
+        "8",
         "--fs",
         "12800",
         "--out",
@@ -333,24 +336,133 @@ fn replay_of_a_log_without_metadata_says_it_falls_back_to_the_embedded_default()
     ]);
     assert!(imported.status.success(), "{}", stderr_of(&imported));
     let log = mcap_files(&dir.join("log"));
+    let mtime_ns = std::fs::metadata(&csv)
+        .unwrap()
+        .modified()
+        .unwrap()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_nanos() as u64;
+    if let Some(py) = python_mcap() {
+        let read = python_metadata(&py, &log[0]);
+        let run = &read["metadata"]["bearingd.run"][0];
+        assert_eq!(run["log_time_origin_ns"], mtime_ns.to_string(), "{read}");
+        assert_eq!(read["first_log_time"], mtime_ns, "{read}");
+        let import = &read["metadata"]["bearingd.import"][0];
+        assert_eq!(import["source"], csv.to_str().unwrap(), "{read}");
+        assert_eq!(import["time_source"], "file modification time", "{read}");
+        let channel = &read["metadata"]["bearingd.channel"][0];
+        assert_eq!(channel["sample_rate_hz"], "12800", "{read}");
+        assert!(read["metadata"]["bearingd.config"][0]["json"]
+            .as_str()
+            .unwrap()
+            .contains("\"imported\""));
+    }
+
+    let (summary, stderr) = replay_json(&log, &dir.join("out"), &[]);
+    assert_eq!(summary["settings_from"], "log", "{summary}\n{stderr}");
+    assert_eq!(summary["samples"], 8 * 12_800, "{summary}");
+    assert!(!stderr.contains("carries no settings"), "{stderr}");
+    let from_log = logged_flags(&mcap_files(&dir.join("out")));
+    assert!(
+        from_log.iter().any(|f| f.1 == "outer_race"),
+        "the simulated outer-race fault was not flagged: {from_log:?}"
+    );
+    let (summary, _) = replay_json(
+        &log,
+        &dir.join("out2"),
+        &["--config", dir.join("log/replay.toml").to_str().unwrap()],
+    );
+    assert_eq!(summary["settings_from"], "config", "{summary}");
+    assert_eq!(logged_flags(&mcap_files(&dir.join("out2"))), from_log);
+}
+
+/// A log without the metadata records (as an older bearingd wrote) is replayed with the
+/// embedded default, and that is said.
+#[test]
+fn replay_of_a_log_without_metadata_says_it_falls_back_to_the_embedded_default() {
+    use bearingd::messages::{ChannelId, RawBlock};
+    use bearingd::sinks::mcap::{LoggerConfig, McapLogger};
+    let dir = scratch_dir("replay-bare");
+    let origin = 1_700_000_000_000_000_000u64;
+    let mut logger = McapLogger::create(LoggerConfig::new(dir.join("log")), origin).unwrap();
+    for k in 0..20u64 {
+        let block = PipelineMessage::Raw(RawBlock {
+            channel: ChannelId {
+                sensor: "older".into(),
+                axis: "radial".into(),
+            },
+            first_sample: k * 1280,
+            sample_rate_hz: 12_800.0,
+            scale_g_per_count: 1e-4,
+            counts: vec![0; 1280],
+        });
+        let at = origin + k * 100_000_000;
+        logger.log(&block, at, at).unwrap();
+    }
+    logger.finish().unwrap();
+    let log = mcap_files(&dir.join("log"));
     let (summary, stderr) = replay_json(&log, &dir.join("out"), &[]);
     assert_eq!(summary["settings_from"], "embedded_default", "{summary}");
     assert!(
         stderr.contains("carries no settings") && stderr.contains("give --config"),
         "{stderr}"
     );
-    // The embedded default has no sensor `imported`: skipped, and said.
+    // The embedded default has no sensor `older`: skipped, and said.
+    assert_eq!(summary["unknown_channels"][0], "older/radial", "{summary}");
+}
+
+/// (channel, kind, stage, sample) of every health message in the logs.
+fn logged_health(files: &[PathBuf]) -> Vec<(String, String, String, u64)> {
+    read_messages(files)
+        .filter_map(|m| match m.expect("readable log").message {
+            PipelineMessage::Health(h) => Some((
+                h.channel.to_string(),
+                format!("{:?}", h.kind),
+                format!("{:?}", h.stage),
+                h.end_sample,
+            )),
+            _ => None,
+        })
+        .collect()
+}
+
+/// A restarted daemon starts from the baselines it loaded (`baselines.json`); its log records
+/// them (`bearingd.state`), so a replay of that run alone starts from the same state and
+/// writes the live run's health messages, not a relearning.
+#[test]
+fn the_replay_of_a_restarted_run_starts_from_the_baselines_the_daemon_loaded() {
+    use bearingd::mcap_log::header::read_header;
+    let dir = scratch_dir("replay-state");
+    let data = dir.join("data");
+    let config = config_at(&dir, "state", 12_800, 3600);
+    fast_run(&config, &data, "40");
+    let first_run = mcap_files(&data.join("mcap"));
+    let first = read_header(&first_run[0]).unwrap();
     assert_eq!(
-        summary["unknown_channels"][0], "imported/radial",
-        "{summary}"
+        first.start_baselines_json.as_deref(),
+        Some("[]"),
+        "{first:?}"
+    );
+    fast_run(&config, &data, "20");
+    let second_run: Vec<PathBuf> = mcap_files(&data.join("mcap"))
+        .into_iter()
+        .filter(|f| !first_run.contains(f))
+        .collect();
+    let header = read_header(&second_run[0]).unwrap();
+    let loaded = std::fs::read_to_string(data.join("state/baselines.json")).ok();
+    let logged = header.start_baselines_json.clone().unwrap_or_default();
+    assert!(
+        logged.contains("motor-de"),
+        "the restart's log records no baselines: {logged} (baselines.json: {loaded:?})"
     );
 
-    // With the config import wrote, it is replayed, and no fallback is said.
-    let (summary, stderr) = replay_json(
-        &log,
-        &dir.join("out2"),
-        &["--config", dir.join("log/replay.toml").to_str().unwrap()],
-    );
-    assert_eq!(summary["samples"], 2 * 12_800, "{summary}");
-    assert!(!stderr.contains("carries no settings"), "{stderr}");
+    let (summary, _) = replay_json(&second_run, &dir.join("replay"), &[]);
+    assert_eq!(summary["runs"][0]["baselines_from"], "log", "{summary}");
+    let live = logged_health(&second_run);
+    let replayed = logged_health(&mcap_files(&dir.join("replay")));
+    assert_eq!(replayed, live);
+    // The replay's own log records the same starting state.
+    let again = read_header(&mcap_files(&dir.join("replay"))[0]).unwrap();
+    assert_eq!(again.start_baselines_json.as_deref(), Some(logged.as_str()));
 }

@@ -42,6 +42,14 @@ impl Checker {
             "give the age in seconds at which an MCAP file is closed and the next begun, e.g. \
              mcap_max_file_s = 3600",
         );
+        let mcap_fsync_interval_s = self.number(
+            "outputs.mcap_fsync_interval_s",
+            &raw.mcap_fsync_interval_s,
+            d.mcap_fsync_interval_s,
+            Limits::within(0.0, 3600.0),
+            "give the seconds of data between two forced writes of the open MCAP file to the \
+             disk (what a power cut can lose), e.g. mcap_fsync_interval_s = 5",
+        );
         let budget_fix = "give the disk space in MiB that MCAP files may fill before the \
                           oldest is deleted, at least twice mcap_max_file_mb, e.g. \
                           mcap_disk_budget_mb = 4096";
@@ -124,6 +132,7 @@ impl Checker {
             mcap_dir: mcap_dir?,
             mcap_max_file_mb: mcap_max_file_mb?,
             mcap_max_file_s: mcap_max_file_s?,
+            mcap_fsync_interval_s: mcap_fsync_interval_s?,
             mcap_disk_budget_mb: mcap_disk_budget_mb?,
             alerts_service: alerts_service?,
             iceoryx2_root: iceoryx2_root?,

@@ -10,12 +10,19 @@
 //! - `bearingd.config`: `json`, the resolved configuration.
 //! - `bearingd.channel`, one per sensor axis: `channel`, `topic`, `sample_rate_hz`, `unit`
 //!   (`g`), `scale_g_per_count`, `bearing` (name) and `bearing_geometry` (JSON).
+//! - `bearingd.state`: `baselines_json` and `channels`: the health baselines the run started
+//!   with (loaded from `baselines.json`; `[]` when it learns from scratch), so that a replay
+//!   starts every run where the daemon did.
 //! - `bearingd.file`: `sequence` (1 for the first file of the run, 2 after the first
 //!   rotation, ...) and `opened_at_utc`; written by the logger itself.
 
+use crate::analysis::health::{baselines_to_json, Baseline};
 use crate::config::Config;
 use crate::mcap_log::files::utc_text;
-use crate::mcap_log::header::{CHANNEL_RECORD, CONFIG_RECORD, FILE_RECORD, RUN_RECORD};
+use crate::mcap_log::header::{
+    CHANNEL_RECORD, CONFIG_RECORD, FILE_RECORD, RUN_RECORD, STATE_RECORD,
+};
+use crate::messages::ChannelId;
 use std::collections::BTreeMap;
 
 /// One metadata record: name and key/value pairs.
@@ -29,8 +36,13 @@ fn record(name: &str, pairs: impl IntoIterator<Item = (&'static str, String)>) -
 }
 
 /// The records every file of a run carries (all but `bearingd.file`), for `config` and a log
-/// whose sample 0 is at `origin_ns`, in the run that started at `run_id`.
-pub fn run_records(config: &Config, origin_ns: u64, run_id: u64) -> Vec<MetadataRecord> {
+/// whose sample 0 is at `origin_ns`, in the run that started at `run_id` with `baselines`.
+pub fn run_records(
+    config: &Config,
+    origin_ns: u64,
+    run_id: u64,
+    baselines: &BTreeMap<ChannelId, Baseline>,
+) -> Vec<MetadataRecord> {
     let mut records = vec![
         record(
             RUN_RECORD,
@@ -56,6 +68,13 @@ pub fn run_records(config: &Config, origin_ns: u64, run_id: u64) -> Vec<Metadata
             )],
         ),
     ];
+    records.push(record(
+        STATE_RECORD,
+        [
+            ("baselines_json", baselines_to_json(baselines)),
+            ("channels", baselines.len().to_string()),
+        ],
+    ));
     for sensor in &config.sensors {
         for axis in &sensor.axes {
             let channel = format!("{}/{axis}", sensor.id);

@@ -1,7 +1,8 @@
 //! The MCAP log as a sink: the writer with rotation and a disk budget ([`writer`]), the
 //! start-up recovery of files a crash left unfinished ([`recover`]), and [`McapSink`], which
 //! maps sample time to log time, flushes the open chunk every second of data (a crash loses at
-//! most that), recovers unfinished files at start, and finishes the file at shutdown. It also
+//! most that), forces it to the disk every `mcap_fsync_interval_s` of data (what a power cut
+//! loses), recovers unfinished files at start, and finishes the file at shutdown. It also
 //! begins every file opened by rotation with the current state (`/state`), writes a `/log`
 //! note for each retention deletion, and pauses logging when a write fails (a full disk)
 //! without stopping the pipeline, resuming when the directory has room ([`LogNotice`]). The
@@ -17,11 +18,12 @@ pub use recover::{
 };
 pub use writer::{enforce_budget, LogStats, LoggerConfig, McapLogger, RetentionReport, TopicStats};
 
+use crate::analysis::health::Baseline;
 use crate::config::Config;
 use crate::mcap_log::schema::{LogLevel, StateSnapshot};
 use crate::mcap_log::McapLogError;
 use crate::messages::{
-    FlagMessage, HealthMessage, PipelineMessage, TwinMessage, VelocityFlagMessage,
+    ChannelId, FlagMessage, HealthMessage, PipelineMessage, TwinMessage, VelocityFlagMessage,
 };
 use crate::pipeline::{Sink, SinkError};
 use std::collections::{BTreeMap, HashMap};
@@ -119,9 +121,13 @@ pub struct McapSink {
     /// Sample rate per sensor, to turn sample indices into time.
     rates: HashMap<String, f64>,
     next_flush_ns: u64,
+    /// When the open file is next forced to the disk (`None`: never).
+    next_sync_ns: Option<u64>,
     last_ns: u64,
     /// Log time of the last flush that reached the file.
     flushed_ns: u64,
+    /// Log time of the last flush forced to the disk: what survives a power cut.
+    synced_ns: u64,
     errors: Vec<McapLogError>,
     pub messages: u64,
     state: CurrentState,
@@ -144,6 +150,7 @@ impl McapSink {
             source,
         })?;
         let recovered = recover_directory(&config.dir)?;
+        let next_sync_ns = config.fsync_every_ns.map(|every| origin_ns + every);
         let logger = McapLogger::create(config, origin_ns)?;
         Ok((
             McapSink {
@@ -151,8 +158,10 @@ impl McapSink {
                 origin_ns,
                 rates,
                 next_flush_ns: origin_ns + FLUSH_EVERY_NS,
+                next_sync_ns,
                 last_ns: origin_ns,
                 flushed_ns: origin_ns,
+                synced_ns: origin_ns,
                 errors: Vec::new(),
                 messages: 0,
                 state: CurrentState::default(),
@@ -165,12 +174,14 @@ impl McapSink {
 
     /// [`open`](Self::open) with the log settings of `config`'s `[outputs]`, its sensors'
     /// sample rates, and the metadata that makes each file self-describing
-    /// ([`metadata::run_records`]; the run is named by `origin_ns`).
+    /// ([`metadata::run_records`]; the run is named by `origin_ns` and starts with
+    /// `baselines`).
     pub fn for_config(
         config: &Config,
         origin_ns: u64,
+        baselines: &BTreeMap<ChannelId, Baseline>,
     ) -> Result<(Self, Vec<RecoveryReport>), McapLogError> {
-        McapSink::for_run(config, origin_ns, origin_ns)
+        McapSink::for_run(config, origin_ns, origin_ns, baselines)
     }
 
     /// [`for_config`](Self::for_config) for a run named `run_id` (a replay keeps the
@@ -179,9 +190,10 @@ impl McapSink {
         config: &Config,
         origin_ns: u64,
         run_id: u64,
+        baselines: &BTreeMap<ChannelId, Baseline>,
     ) -> Result<(Self, Vec<RecoveryReport>), McapLogError> {
         let logger = LoggerConfig {
-            metadata: metadata::run_records(config, origin_ns, run_id),
+            metadata: metadata::run_records(config, origin_ns, run_id, baselines),
             ..logger_config(config)
         };
         McapSink::open(logger, config.sample_rates(), origin_ns)
@@ -205,6 +217,21 @@ impl McapSink {
 
     pub fn current_path(&self) -> Option<&Path> {
         self.logger.as_ref().and_then(|l| l.current_path())
+    }
+
+    /// Log time up to which the log survives a crash of the process (the last flush).
+    pub fn flushed_until_ns(&self) -> u64 {
+        self.flushed_ns
+    }
+
+    /// Log time up to which the log survives a power cut (the last fsync).
+    pub fn synced_until_ns(&self) -> u64 {
+        self.synced_ns
+    }
+
+    /// The open logger's counters (`None` once finished).
+    pub fn log_stats(&self) -> Option<&LogStats> {
+        self.logger.as_ref().map(McapLogger::stats)
     }
 
     fn log_time(&self, message: &PipelineMessage) -> u64 {
@@ -459,9 +486,26 @@ impl McapSink {
         }
         if self.last_ns >= self.next_flush_ns {
             self.next_flush_ns = self.last_ns + FLUSH_EVERY_NS;
-            let flushed = self.logger.as_mut().map_or(Ok(()), McapLogger::flush);
-            match flushed {
-                Ok(()) => self.flushed_ns = self.last_ns,
+            let sync = self.next_sync_ns.is_some_and(|at| self.last_ns >= at);
+            let Some(logger) = self.logger.as_mut() else {
+                return;
+            };
+            let done = if sync {
+                self.next_sync_ns = logger
+                    .config()
+                    .fsync_every_ns
+                    .map(|every| self.last_ns + every);
+                logger.sync()
+            } else {
+                logger.flush()
+            };
+            match done {
+                Ok(()) => {
+                    self.flushed_ns = self.last_ns;
+                    if sync {
+                        self.synced_ns = self.last_ns;
+                    }
+                }
                 Err(e) => self.pause(&e, time),
             }
         }
@@ -476,6 +520,52 @@ pub fn logger_config(config: &Config) -> LoggerConfig {
         max_file_duration_ns: (o.mcap_max_file_s * 1e9) as u64,
         disk_budget_bytes: o.mcap_disk_budget_bytes(),
         chunk_size: (1u64 << 19).min(o.mcap_max_file_bytes() / 4).max(4096),
+        fsync_every_ns: Some((o.mcap_fsync_interval_s * 1e9) as u64),
         ..LoggerConfig::new(o.mcap_dir.clone())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::messages::{ChannelId, HealthKind, HealthMessage};
+
+    fn health_at(end_sample: u64) -> PipelineMessage {
+        PipelineMessage::Health(HealthMessage {
+            channel: ChannelId {
+                sensor: "s".into(),
+                axis: "radial".into(),
+            },
+            end_sample,
+            kind: HealthKind::Gap,
+            stage: None,
+            detail: String::new(),
+        })
+    }
+
+    #[test]
+    fn the_open_file_is_forced_to_the_disk_on_the_configured_period() {
+        let dir = tempfile::tempdir().unwrap();
+        let config = LoggerConfig {
+            fsync_every_ns: Some(3_000_000_000),
+            ..LoggerConfig::new(dir.path())
+        };
+        let rates = HashMap::from([("s".to_string(), 1000.0)]);
+        let origin = 1_700_000_000_000_000_000;
+        let (mut sink, _) = McapSink::open(config, rates, origin).unwrap();
+        // 20 s of data, a message every 100 ms (100 samples at 1 kHz).
+        for k in 1..=200 {
+            sink.write(&health_at(k * 100));
+        }
+        let stats = sink.log_stats().unwrap();
+        // Flushed every second of data, forced to the disk every third second.
+        assert_eq!(stats.flushes, 20, "{stats:?}");
+        assert_eq!(
+            stats.syncs, 6,
+            "fsyncs at 3, 6, 9, 12, 15, 18 s of data: {stats:?}"
+        );
+        assert_eq!(sink.flushed_until_ns() - origin, 20_000_000_000);
+        assert_eq!(sink.synced_until_ns() - origin, 18_000_000_000);
+        sink.finish().unwrap();
     }
 }

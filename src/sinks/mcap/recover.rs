@@ -356,7 +356,7 @@ fn parent_dir(path: &Path) -> &Path {
 
 /// Makes a rename in `path`'s directory durable; a directory that cannot be opened for fsync
 /// is not fatal.
-fn sync_parent(path: &Path) {
+pub(super) fn sync_parent(path: &Path) {
     if let Ok(d) = File::open(parent_dir(path)) {
         let _ = d.sync_all();
     }

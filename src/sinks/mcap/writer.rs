@@ -48,6 +48,10 @@ pub struct LoggerConfig {
     /// self-describing: see [`super::metadata`]); each file also gets a `bearingd.file` record
     /// with its sequence number in the run.
     pub metadata: Vec<(String, BTreeMap<String, String>)>,
+    /// Log time between two forced writes of the open file to the disk (fsync), for the owner
+    /// to schedule [`McapLogger::sync`]; `None`: never forced (the OS writes back when it
+    /// will), as in tests and tools.
+    pub fsync_every_ns: Option<u64>,
 }
 
 impl LoggerConfig {
@@ -62,6 +66,7 @@ impl LoggerConfig {
             disk_budget_bytes: 4 * 1024 * 1024 * 1024,
             zstd_level: 3,
             metadata: Vec::new(),
+            fsync_every_ns: None,
         }
     }
 
@@ -106,6 +111,8 @@ pub struct LogStats {
     /// Bytes of the files this logger finished (final sizes).
     pub finished_file_bytes: u64,
     pub flushes: u64,
+    /// Times the open file was forced to the disk ([`McapLogger::sync`]).
+    pub syncs: u64,
     pub files_deleted: u64,
     pub bytes_deleted: u64,
 }
@@ -182,6 +189,8 @@ type FileWriter = mcap::Writer<Counting<BufWriter<File>>>;
 struct OpenFile {
     path: PathBuf,
     writer: FileWriter,
+    /// A second handle on the same file, for fsync: the writer owns the first.
+    disk: File,
     len: Arc<AtomicU64>,
     first_log_time: Option<u64>,
     /// topic → (channel id, next sequence)
@@ -222,6 +231,11 @@ impl OpenFile {
                 Err(e) => return Err(io_err(&path, "create")(e)),
             }
         };
+        // The new name must survive a power cut as well as the data written under it.
+        super::recover::sync_parent(&path);
+        let disk = file
+            .try_clone()
+            .map_err(io_err(&path, "open a second handle"))?;
         let len = Arc::new(AtomicU64::new(0));
         let stream = Counting {
             inner: BufWriter::with_capacity(256 * 1024, file),
@@ -257,6 +271,7 @@ impl OpenFile {
         Ok(OpenFile {
             path,
             writer,
+            disk,
             len,
             first_log_time: None,
             channels: HashMap::new(),
@@ -416,6 +431,7 @@ impl McapLogger {
     pub fn create(config: LoggerConfig, opened_at_ns: u64) -> Result<Self> {
         config.check()?;
         std::fs::create_dir_all(&config.dir).map_err(io_err(&config.dir, "create directory"))?;
+        super::recover::sync_parent(&config.dir);
         let mut logger = McapLogger {
             config,
             open: None,
@@ -601,8 +617,20 @@ impl McapLogger {
         Ok(rotation)
     }
 
+    /// [`flush`](Self::flush), then forces the open file to the disk (fsync of its data), which
+    /// bounds what a power cut can lose as `flush` bounds what a process crash can.
+    pub fn sync(&mut self) -> Result<()> {
+        self.flush()?;
+        if let Some(file) = self.open.as_mut() {
+            file.disk.sync_data().map_err(io_err(&file.path, "fsync"))?;
+            self.stats.syncs += 1;
+        }
+        Ok(())
+    }
+
     /// Closes the open chunk and hands it to the OS, bounding what a crash can lose. (No fsync:
-    /// a process crash loses nothing that was flushed; a power loss is the file system's call.)
+    /// a process crash loses nothing that was flushed; a power loss is the file system's call,
+    /// bounded by [`sync`](Self::sync).)
     pub fn flush(&mut self) -> Result<()> {
         if let Some(file) = self.open.as_mut() {
             file.writer.flush().map_err(|source| McapLogError::Write {

@@ -34,6 +34,8 @@ pub struct PlannedRun {
     pub run_id: Option<u64>,
     /// Wall-clock time of the run's sample 0, from its metadata.
     pub origin_ns: Option<u64>,
+    /// The health baselines the run started with (its `bearingd.state` record), as JSON.
+    pub start_baselines_json: Option<String>,
     pub files: Range<usize>,
 }
 
@@ -81,6 +83,7 @@ impl ReplayPlan {
                 _ => runs.push(PlannedRun {
                     run_id: file.run_id,
                     origin_ns: file.origin_ns,
+                    start_baselines_json: file.start_baselines_json.clone(),
                     files: i..i + 1,
                 }),
             }
