@@ -103,6 +103,7 @@ fn a_monitor_takes_hops_and_speed_changes_without_allocating() {
         // One selection after 4 s, the next far beyond the test.
         band_period_samples: (1e6 * fs) as u64,
         band_phase_samples: 0,
+        window_stagger: (0, 1),
         band_history_samples: (4.0 * fs) as usize,
         flags: FlagSettings {
             watch_score: 10.0,

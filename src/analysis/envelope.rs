@@ -405,6 +405,8 @@ pub struct RollingEnvelope {
     /// Index in `ring` where the next sample goes; also where the oldest sample is once full.
     write_at: usize,
     until_update: usize,
+    /// Samples by which every window end is delayed, below a hop ([`Self::with_phase`]).
+    phase: usize,
     samples_seen: u64,
     transform: WindowTransform,
     bands: Vec<RollingBand>,
@@ -430,6 +432,7 @@ impl RollingEnvelope {
             ring: vec![0.0; window],
             write_at: 0,
             until_update: window,
+            phase: 0,
             samples_seen: 0,
             transform,
             bands: Vec::new(),
@@ -438,6 +441,15 @@ impl RollingEnvelope {
         };
         rolling.set_bands(bands);
         rolling
+    }
+
+    /// Ends every window `phase` samples later (less than a hop): the first after
+    /// `window + phase` samples, then every hop. Channels of one daemon take different phases
+    /// so that their windows do not all close on the same block.
+    pub fn with_phase(mut self, phase: usize) -> Self {
+        self.phase = phase.min(self.hop - 1);
+        self.until_update = self.ring.len() + self.phase;
+        self
     }
 
     pub fn bands(&self) -> &[RollingBand] {
@@ -482,7 +494,7 @@ impl RollingEnvelope {
     /// a gap) and restarts the averages. `next_sample` is the sample index of the next sample.
     pub fn restart_at(&mut self, next_sample: u64) {
         self.write_at = 0;
-        self.until_update = self.ring.len();
+        self.until_update = self.ring.len() + self.phase;
         self.samples_seen = next_sample;
         self.history_used = 0;
         self.history_next = 0;

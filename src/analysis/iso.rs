@@ -406,6 +406,8 @@ pub struct VelocityTracker {
     samples: u64,
     /// Samples until the next hop ends.
     to_next_hop: usize,
+    /// Samples by which every window end is delayed, below a hop ([`Self::with_phase`]).
+    phase: usize,
     /// Mean squares of the last windows, circular.
     history: Vec<f64>,
     history_len: usize,
@@ -438,14 +440,27 @@ impl VelocityTracker {
             hop,
             samples: 0,
             to_next_hop: window,
+            phase: 0,
             history: vec![0.0; averages.max(1)],
             history_len: 0,
             history_pos: 0,
         }
     }
 
+    /// Ends every window `phase` samples later (less than a hop), as
+    /// [`RollingEnvelope::with_phase`](crate::analysis::envelope::RollingEnvelope::with_phase).
+    pub fn with_phase(mut self, phase: usize) -> Self {
+        self.phase = phase.min(self.hop.saturating_sub(1));
+        self.to_next_hop = self.ring.len() + self.phase;
+        self
+    }
+
     pub fn window(&self) -> usize {
         self.ring.len()
+    }
+
+    pub fn hop(&self) -> usize {
+        self.hop
     }
 
     pub fn limits(&self) -> ZoneLimits {
@@ -461,7 +476,7 @@ impl VelocityTracker {
     /// restart): the next reading comes one whole window later, from new windows only.
     pub fn restart_at(&mut self, first_sample: u64) {
         self.samples = first_sample;
-        self.to_next_hop = self.ring.len();
+        self.to_next_hop = self.ring.len() + self.phase;
         self.ring_pos = 0;
         self.history_len = 0;
         self.history_pos = 0;

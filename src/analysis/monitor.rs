@@ -67,6 +67,12 @@ pub struct MonitorSettings {
     /// same sample time: each selection holds the analysis thread for tens of ms, and a burst
     /// over all channels delays every block (and alert) behind it. 0 for a lone channel.
     pub band_phase_samples: u64,
+    /// This channel's share of a hop, `(k, n)` for the k-th of n channels: its windows end
+    /// k/n of a hop later than the first channel's, so that the daemon's channels do not all
+    /// close a window (envelope spectra, scores, flags, velocity) on the same block, each
+    /// waiting behind the others; a window's alert then waits for one channel's work, not
+    /// all. `(0, 1)` for a lone channel.
+    pub window_stagger: (usize, usize),
     pub band_history_samples: usize,
     pub flags: FlagSettings,
     pub baseline_windows: u64,
@@ -236,6 +242,11 @@ pub struct ChannelMonitor {
 /// Samples converted per chunk (the scratch buffer's size).
 const CHUNK: usize = 4096;
 
+/// The k/n share of `hop` of the k-th of n channels ([`MonitorSettings::window_stagger`]).
+fn share_of(hop: usize, (k, n): (usize, usize)) -> usize {
+    (hop * k.min(n)) / n.max(1)
+}
+
 impl ChannelMonitor {
     pub fn new(
         settings: MonitorSettings,
@@ -273,6 +284,8 @@ impl ChannelMonitor {
                 settings.analysis.averages,
                 &mut crate::analysis::envelope::FftPlans::default(),
             );
+            let phase = share_of(tracker.hop(), settings.window_stagger);
+            let tracker = tracker.with_phase(phase);
             let flag = FaultFlag::new(tracker.limits().flag_settings(&settings.flags));
             (tracker, flag)
         });
@@ -285,7 +298,8 @@ impl ChannelMonitor {
                 settings.analysis.averages,
                 &[],
                 bins,
-            ),
+            )
+            .with_phase(share_of(hop, settings.window_stagger)),
             scorer,
             flags: std::array::from_fn(|_| FaultFlag::new(settings.flags)),
             health: HealthTracker::new(

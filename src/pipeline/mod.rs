@@ -158,8 +158,8 @@ pub struct Pipeline {
 
 /// The monitor settings of one sensor: the config's durations turned into samples.
 ///
-/// `turn` of `turns` staggers the channel's band selections among the daemon's channels
-/// ([`MonitorSettings::band_phase_samples`]).
+/// `turn` of `turns` staggers the channel's band selections and window ends among the daemon's
+/// channels ([`MonitorSettings::band_phase_samples`], [`MonitorSettings::window_stagger`]).
 pub fn monitor_settings(
     config: &Config,
     sensor: &SensorConfig,
@@ -174,6 +174,7 @@ pub fn monitor_settings(
         analysis: config.analysis.clone(),
         band_period_samples: samples(config.band_period_s),
         band_phase_samples: samples(config.band_period_s * turn as f64 / turns.max(1) as f64),
+        window_stagger: (turn, turns.max(1)),
         band_history_samples: samples(band_history_s(config)) as usize,
         flags: FlagSettings {
             watch_score: t.watch_score,

@@ -16,6 +16,7 @@ fn settings(fs: f64) -> MonitorSettings {
         analysis: AnalysisSettings::default(),
         band_period_samples: (20.0 * fs) as u64,
         band_phase_samples: 0,
+        window_stagger: (0, 1),
         band_history_samples: (10.0 * fs) as usize,
         flags: FlagSettings {
             watch_score: 10.0,
@@ -361,6 +362,7 @@ fn a_band_phase_staggers_the_selections_after_the_first() {
     let staggered = band_selections(
         MonitorSettings {
             band_phase_samples: phase,
+            window_stagger: (0, 1),
             ..settings(fs)
         },
         &counts,
@@ -455,6 +457,53 @@ fn the_velocity_zone_flag_rises_and_falls_with_the_fault_flags_hysteresis() {
             (at(seconds) - want).abs() / want < 0.01,
             "{seconds} s: {} vs {want} mm/s",
             at(seconds)
+        );
+    }
+}
+
+/// Issue 12 item 4: the k-th of n channels ends its windows (envelope and velocity) k/n of a
+/// hop later than a lone channel does, so the daemon's channels do not all close a window on
+/// the same block; the windows themselves stay one hop apart.
+#[test]
+fn a_window_stagger_moves_every_window_end_by_its_share_of_the_hop() {
+    let (counts, params) = counts(12.0, 0.0);
+    let fs = params.fs_hz;
+    let ends = |stagger: (usize, usize)| {
+        let mut monitor = ChannelMonitor::new(
+            MonitorSettings {
+                window_stagger: stagger,
+                ..settings(fs)
+            },
+            params.frequencies(),
+            None,
+        );
+        let (mut windows, mut velocity) = (Vec::new(), Vec::new());
+        for (i, block) in counts.chunks(1_000).enumerate() {
+            monitor.push_counts((i * 1_000) as u64, block, SCALE, &mut |e| match e {
+                MonitorEvent::Window(w) => windows.push(w.end_sample),
+                MonitorEvent::Velocity { reading, .. } => velocity.push(reading.end_sample),
+                _ => {}
+            });
+        }
+        (windows, velocity)
+    };
+    let (lone, lone_velocity) = ends((0, 1));
+    let (third, third_velocity) = ends((1, 3));
+    assert!(
+        lone.len() > 10 && lone_velocity.len() > 5,
+        "{lone:?} {lone_velocity:?}"
+    );
+    let hop = lone[1] - lone[0];
+    let velocity_hop = lone_velocity[1] - lone_velocity[0];
+    assert!(lone.windows(2).all(|w| w[1] - w[0] == hop));
+    for (a, b) in lone.iter().zip(&third) {
+        assert_eq!(b - a, hop / 3, "envelope windows: {lone:?} vs {third:?}");
+    }
+    for (a, b) in lone_velocity.iter().zip(&third_velocity) {
+        assert_eq!(
+            b - a,
+            velocity_hop / 3,
+            "velocity: {lone_velocity:?} vs {third_velocity:?}"
         );
     }
 }
