@@ -28,47 +28,20 @@ CASES=${CAN_VM_CASES:-classic fd malformed restart run}
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 WORK=${1:-$ROOT/target/can-vm}
 mkdir -p "$WORK"
+WORK=$(cd "$WORK" && pwd)
 export DEBIAN_FRONTEND=noninteractive
-started=$(date +%s)
-say() { printf '[can-vm %3ss] %s\n' "$(( $(date +%s) - started ))" "$*"; }
-missing() {
-  echo "can-vm: missing $1; install it with: $2" >&2
-  exit 1
-}
+NAME=can-vm
+. "$ROOT/tests/vm/common.sh"
 
-# 1. Host tools. Installed here when possible (root), never skipped.
-need_apt=()
-command -v qemu-system-x86_64 >/dev/null || need_apt+=(qemu-system-x86)
-command -v musl-gcc >/dev/null || need_apt+=(musl-tools)
-if [ ${#need_apt[@]} -gt 0 ]; then
-  if [ "$(id -u)" = 0 ]; then
-    say "apt-get install ${need_apt[*]}"
-    apt-get install -y -q --no-install-recommends "${need_apt[@]}" >/dev/null
-  else
-    missing "${need_apt[*]}" "apt-get install ${need_apt[*]} (as root)"
-  fi
-fi
-rustup target list --installed | grep -q x86_64-unknown-linux-musl ||
-  rustup target add x86_64-unknown-linux-musl >/dev/null ||
-  missing "Rust target x86_64-unknown-linux-musl" "rustup target add x86_64-unknown-linux-musl"
+# 1. Host tools.
+vm_host_tools
 python=${PYTHON:-$ROOT/.venv/bin/python}
 [ -x "$python" ] || python=python3
 "$python" -c 'import cantools' 2>/dev/null ||
   missing "the Python package cantools" "pip install -r scripts/requirements-ci.txt (.ci/run makes .venv)"
 
-# 2. Kernel and busybox: downloaded and unpacked, not installed (cached in $WORK).
-KPKG=$(apt-cache depends linux-image-amd64 | awk '/Depends: linux-image-[0-9]/{print $2; exit}')
-[ -n "$KPKG" ] || missing "the Debian kernel package name" "apt-get update"
-KVER=${KPKG#linux-image-}
-if [ ! -f "$WORK/kroot/boot/vmlinuz-$KVER" ] || [ ! -x "$WORK/bbroot/bin/busybox" ]; then
-  say "download $KPKG busybox-static"
-  (cd "$WORK" && rm -f ./*.deb && apt-get download -q "$KPKG" busybox-static >/dev/null)
-  rm -rf "$WORK/kroot" "$WORK/bbroot"
-  dpkg-deb -x "$WORK/$KPKG"_*.deb "$WORK/kroot"
-  dpkg-deb -x "$WORK"/busybox-static_*.deb "$WORK/bbroot"
-fi
-MODDIR=$WORK/kroot/lib/modules/$KVER/kernel
-BB=$WORK/bbroot/bin/busybox
+# 2. Kernel and busybox.
+vm_kernel
 
 # 3. Static binaries, without iceoryx2 (not needed in the VM; shorter build).
 say "cargo build (musl, feature can)"

@@ -23,47 +23,19 @@ ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 WORK=${1:-$ROOT/target/power-vm}
 CUT_AFTER=${POWER_CUT_AFTER:-20}
 mkdir -p "$WORK"
+WORK=$(cd "$WORK" && pwd)
 export DEBIAN_FRONTEND=noninteractive
-started=$(date +%s)
-say() { printf '[power-vm %3ss] %s\n' "$(( $(date +%s) - started ))" "$*"; }
-missing() {
-  echo "power-vm: missing $1; install it with: $2" >&2
-  exit 1
-}
+NAME=power-vm
+. "$ROOT/tests/vm/common.sh"
 
-# 1. Host tools. Installed here when possible (root), never skipped.
-need_apt=()
-command -v qemu-system-x86_64 >/dev/null || need_apt+=(qemu-system-x86)
-command -v musl-gcc >/dev/null || need_apt+=(musl-tools)
-command -v mkfs.ext4 >/dev/null && command -v debugfs >/dev/null || need_apt+=(e2fsprogs)
-if [ ${#need_apt[@]} -gt 0 ]; then
-  if [ "$(id -u)" = 0 ]; then
-    say "apt-get install ${need_apt[*]}"
-    apt-get install -y -q --no-install-recommends "${need_apt[@]}" >/dev/null
-  else
-    missing "${need_apt[*]}" "apt-get install ${need_apt[*]} (as root)"
-  fi
-fi
-rustup target list --installed | grep -q x86_64-unknown-linux-musl ||
-  rustup target add x86_64-unknown-linux-musl >/dev/null ||
-  missing "Rust target x86_64-unknown-linux-musl" "rustup target add x86_64-unknown-linux-musl"
+# 1. Host tools (e2fsprogs: the file system, the journal replay and the copy out of the image).
+vm_host_tools mkfs.ext4:e2fsprogs e2fsck:e2fsprogs debugfs:e2fsprogs
 python=${PYTHON:-$ROOT/.venv/bin/python}
 "$python" -c 'import mcap' 2>/dev/null ||
   missing "the Python package mcap" "pip install -r scripts/requirements-ci.txt (.ci/run makes .venv)"
 
-# 2. Kernel and busybox: downloaded and unpacked, not installed (cached in $WORK).
-KPKG=$(apt-cache depends linux-image-amd64 | awk '/Depends: linux-image-[0-9]/{print $2; exit}')
-[ -n "$KPKG" ] || missing "the Debian kernel package name" "apt-get update"
-KVER=${KPKG#linux-image-}
-if [ ! -f "$WORK/kroot/boot/vmlinuz-$KVER" ] || [ ! -x "$WORK/bbroot/bin/busybox" ]; then
-  say "download $KPKG busybox-static"
-  (cd "$WORK" && rm -f ./*.deb && apt-get download -q "$KPKG" busybox-static >/dev/null)
-  rm -rf "$WORK/kroot" "$WORK/bbroot"
-  dpkg-deb -x "$WORK/$KPKG"_*.deb "$WORK/kroot"
-  dpkg-deb -x "$WORK"/busybox-static_*.deb "$WORK/bbroot"
-fi
-MODDIR=$WORK/kroot/lib/modules/$KVER/kernel
-BB=$WORK/bbroot/bin/busybox
+# 2. Kernel and busybox.
+vm_kernel
 
 # 3. bearingd, static (musl), as the systemd VM test builds it; the host's for the replay.
 say "cargo build --release --locked (musl; host)"

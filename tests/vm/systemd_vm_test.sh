@@ -31,49 +31,20 @@ WORK=${1:-$ROOT/target/systemd-vm}
 mkdir -p "$WORK"
 WORK=$(cd "$WORK" && pwd)
 export DEBIAN_FRONTEND=noninteractive
-started=$(date +%s)
-say() { printf '[systemd-vm %3ss] %s\n' "$(( $(date +%s) - started ))" "$*"; }
-missing() {
-  echo "systemd-vm: missing $1; install it with: $2" >&2
-  exit 1
-}
+NAME=systemd-vm
+. "$ROOT/tests/vm/common.sh"
 SENSOR=vm-sim
 
-# 1. Host tools. Installed here when possible (root), never skipped.
+# 1. Host tools.
 [ "$(id -u)" = 0 ] || missing "root" "run as root (debootstrap and chroot need it)"
-need_apt=()
-command -v qemu-system-x86_64 >/dev/null || need_apt+=(qemu-system-x86)
-command -v musl-gcc >/dev/null || need_apt+=(musl-tools)
-command -v debootstrap >/dev/null || need_apt+=(debootstrap)
-command -v make >/dev/null || need_apt+=(make)
-command -v strip >/dev/null || need_apt+=(binutils)
-if [ ${#need_apt[@]} -gt 0 ]; then
-  say "apt-get install ${need_apt[*]}"
-  apt-get install -y -q --no-install-recommends "${need_apt[@]}" >/dev/null ||
-    missing "${need_apt[*]}" "apt-get update && apt-get install ${need_apt[*]}"
-fi
-rustup target list --installed | grep -q x86_64-unknown-linux-musl ||
-  rustup target add x86_64-unknown-linux-musl >/dev/null ||
-  missing "Rust target x86_64-unknown-linux-musl" "rustup target add x86_64-unknown-linux-musl"
+vm_host_tools debootstrap:debootstrap make:make strip:binutils
 python=${PYTHON:-$ROOT/.venv/bin/python}
 [ -x "$python" ] || python=python3
 "$python" -c 'import mcap.reader' 2>/dev/null ||
   missing "the Python package mcap (1.6)" "pip install -r scripts/requirements-ci.txt (.ci/run makes .venv)"
 
-# 2. Kernel and busybox (for cpio): downloaded and unpacked, not installed (cached in $WORK).
-KPKG=$(apt-cache depends linux-image-amd64 | awk '/Depends: linux-image-[0-9]/{print $2; exit}')
-[ -n "$KPKG" ] || missing "the Debian kernel package name" "apt-get update"
-KVER=${KPKG#linux-image-}
-if [ ! -f "$WORK/kroot/boot/vmlinuz-$KVER" ] || [ ! -x "$WORK/bbroot/bin/busybox" ]; then
-  say "download $KPKG busybox-static"
-  (cd "$WORK" && rm -f ./*.deb && apt-get download -q "$KPKG" busybox-static >/dev/null) ||
-    missing "$KPKG or busybox-static from the Debian mirror" "apt-get update (network to the mirror)"
-  rm -rf "$WORK/kroot" "$WORK/bbroot"
-  dpkg-deb -x "$WORK/$KPKG"_*.deb "$WORK/kroot"
-  dpkg-deb -x "$WORK"/busybox-static_*.deb "$WORK/bbroot"
-  rm -f "$WORK"/*.deb
-fi
-BB=$WORK/bbroot/bin/busybox
+# 2. Kernel and busybox (for cpio).
+vm_kernel
 
 # 3. The Debian root: debootstrap once, then reused (delete $WORK/base to refresh it).
 if [ ! -x "$WORK/base/lib/systemd/systemd" ]; then
