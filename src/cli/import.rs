@@ -5,11 +5,12 @@
 //! same settings are also written as `DIR/replay.toml`, a starting point for `--config`.
 
 use super::{CliError, RecordingArgs};
+use crate::bearing::BearingGeometry;
 use crate::mcap_log::header::IMPORT_RECORD;
 use crate::messages::{ChannelId, PipelineMessage, RawBlock};
 use crate::offline::{resolve_conditions, AnalyzeRequest};
 use crate::recording::{read_recording, time_from_name, NamedTimeKind};
-use crate::sinks::mcap::metadata::run_records;
+use crate::sinks::mcap::metadata::{run_records, MetadataRecord};
 use crate::sinks::mcap::{LoggerConfig, McapLogger};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -46,57 +47,107 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     for warning in &conditions.warnings {
         eprintln!("bearingd: import: {warning}");
     }
-    let (fs, rpm) = (conditions.fs_hz, conditions.rpm);
-    let bearing = &conditions.bearing;
+    let fs = conditions.fs_hz;
+    let (origin_ns, time_source) = recording_date(&args.file);
+    let written = write_raw_log(&RawLog {
+        out: &args.out,
+        sensor: &args.sensor,
+        samples: &recording.samples,
+        fs_hz: fs,
+        rpm: conditions.rpm,
+        bearing: &conditions.bearing,
+        origin_ns,
+        about: (
+            IMPORT_RECORD.to_string(),
+            [
+                ("source".to_string(), args.file.display().to_string()),
+                ("time_source".to_string(), time_source.to_string()),
+            ]
+            .into(),
+        ),
+        what: &format!("{} (bearingd import)", args.file.display()),
+    })?;
+    let path = written
+        .path
+        .as_ref()
+        .map_or("?".into(), |p| p.display().to_string());
+    println!(
+        "imported {} samples ({:.2} s at {fs} Hz, {:.3e} g per count, dated {} from the {time_source}) into {path}; replay with: bearingd replay {path} (its settings are also in {})",
+        recording.samples.len(),
+        recording.samples.len() as f64 / fs,
+        written.scale,
+        crate::mcap_log::files::utc_text(origin_ns),
+        written.config_path.display()
+    );
+    Ok(())
+}
+
+/// A recording to write as a raw log.
+pub(super) struct RawLog<'a> {
+    pub out: &'a Path,
+    pub sensor: &'a str,
+    pub samples: &'a [f64],
+    pub fs_hz: f64,
+    pub rpm: f64,
+    pub bearing: &'a BearingGeometry,
+    /// Wall-clock time of sample 0, ns since the epoch.
+    pub origin_ns: u64,
+    /// A metadata record saying where the recording came from.
+    pub about: MetadataRecord,
+    /// The recording, for the settings file's first line.
+    pub what: &'a str,
+}
+
+/// What [`write_raw_log`] wrote.
+pub(super) struct WrittenLog {
+    pub path: Option<PathBuf>,
+    pub config_path: PathBuf,
+    pub scale: f64,
+}
+
+/// Writes `log` into `log.out` as a raw MCAP log that describes itself as the daemon's logs do
+/// (the settings to replay it with, short band period and delays since recordings are short),
+/// plus the same settings as `replay.toml`.
+pub(super) fn write_raw_log(log: &RawLog) -> Result<WrittenLog, CliError> {
+    let (fs, rpm, b) = (log.fs_hz, log.rpm, log.bearing);
     let bearing_spec = format!(
         "z={},d={}mm,D={}mm,alpha={}",
-        bearing.rolling_elements,
-        bearing.element_diameter_mm,
-        bearing.pitch_diameter_mm,
-        bearing.contact_angle_deg
+        b.rolling_elements, b.element_diameter_mm, b.pitch_diameter_mm, b.contact_angle_deg
     );
-    let file = args.file.display();
-    let peak = recording.samples.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let peak = log.samples.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let scale = if peak > 0.0 {
         peak / FULL_SCALE_COUNTS
     } else {
         1e-6
     };
     let channel = ChannelId {
-        sensor: args.sensor.clone(),
+        sensor: log.sensor.to_string(),
         axis: "radial".into(),
     };
     let config_text = format!(
-        "# Replays {file} (bearingd import): bearingd replay {out}/*.mcap (the log carries these \
-         settings; give --config {out}/replay.toml after editing it)\n\
+        "# Replays {what}: bearingd replay {out}/*.mcap (the log carries these settings; give \
+         --config {out}/replay.toml after editing it)\n\
          [[sensors]]\nid = \"{sensor}\"\ntransport = \"shm\"\nsample_rate_hz = {fs}\nscale_g_per_count = {scale:e}\naxes = [\"radial\"]\nbearing = \"{bearing_spec}\"\n\
          [sensors.speed]\nsource = \"fixed\"\nrpm = {rpm}\n\n\
          # A recording is short: choose bands every 3 s and raise flags after 1 s.\n\
          [analysis]\nband_period_s = 3.0\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 5.0\nbaseline_windows = 5\n\n\
          [outputs]\nstate_dir = \"{out}/state\"\nmcap_dir = \"{out}/replay\"\n",
-        out = args.out.display(),
-        sensor = args.sensor,
+        what = log.what,
+        out = log.out.display(),
+        sensor = log.sensor,
     );
-    let config_path = args.out.join("replay.toml");
+    let config_path = log.out.join("replay.toml");
     let config = crate::config::parse(&config_text, &config_path.display().to_string())
-        .map_err(|e| CliError::input(format!("the settings import made are refused: {e}")))?;
-    let (origin_ns, time_source) = recording_date(&args.file);
-    let mut metadata = run_records(&config, origin_ns, origin_ns, &Default::default());
-    metadata.push((
-        IMPORT_RECORD.to_string(),
-        [
-            ("source".to_string(), args.file.display().to_string()),
-            ("time_source".to_string(), time_source.to_string()),
-        ]
-        .into(),
-    ));
+        .map_err(|e| CliError::input(format!("the settings of the log are refused: {e}")))?;
+    let mut metadata = run_records(&config, log.origin_ns, log.origin_ns, &Default::default());
+    metadata.push(log.about.clone());
     let logger_config = LoggerConfig {
         metadata,
-        ..LoggerConfig::new(&args.out)
+        ..LoggerConfig::new(log.out)
     };
-    let mut logger = McapLogger::create(logger_config, origin_ns).map_err(CliError::input)?;
+    let mut logger = McapLogger::create(logger_config, log.origin_ns).map_err(CliError::input)?;
     let block = ((fs * BLOCK_S).round() as usize).max(1);
-    for (i, chunk) in recording.samples.chunks(block).enumerate() {
+    for (i, chunk) in log.samples.chunks(block).enumerate() {
         let first_sample = (i * block) as u64;
         let message = PipelineMessage::Raw(RawBlock {
             channel: channel.clone(),
@@ -105,7 +156,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
             scale_g_per_count: scale,
             counts: chunk.iter().map(|x| (x / scale).round() as i32).collect(),
         });
-        let time = origin_ns + (first_sample as f64 / fs * 1e9) as u64;
+        let time = log.origin_ns + (first_sample as f64 / fs * 1e9) as u64;
         logger
             .log(&message, time, time)
             .map_err(CliError::failure)?;
@@ -114,17 +165,11 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     logger.finish().map_err(CliError::failure)?;
     std::fs::write(&config_path, config_text)
         .map_err(|e| CliError::failure(format!("{}: cannot write: {e}", config_path.display())))?;
-    println!(
-        "imported {} samples ({:.2} s at {fs} Hz, {:.3e} g per count, dated {} from the {time_source}) into {}; replay with: bearingd replay {} (its settings are also in {})",
-        recording.samples.len(),
-        recording.samples.len() as f64 / fs,
+    Ok(WrittenLog {
+        path,
+        config_path,
         scale,
-        crate::mcap_log::files::utc_text(origin_ns),
-        path.as_ref().map_or("?".into(), |p| p.display().to_string()),
-        path.as_ref().map_or("?".into(), |p| p.display().to_string()),
-        config_path.display()
-    );
-    Ok(())
+    })
 }
 
 /// When the recording began, ns since the Unix epoch, and where that came from: the date an IMS

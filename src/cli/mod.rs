@@ -10,6 +10,7 @@ mod alerts;
 mod analyze;
 mod calibrate;
 mod config_cmd;
+mod dataset;
 mod evaluate;
 mod fleet_decode;
 mod hw_table;
@@ -108,6 +109,9 @@ enum Command {
     Trend(trend::TrendArgs),
     /// Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV.
     Simulate(simulate::SimulateArgs),
+    /// Generate a labelled synthetic data set (signal model or physics twin) for learned
+    /// diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log.
+    Dataset(dataset::DatasetArgs),
     /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
     /// to a measured record; prints the parameters and the fit error, plots the spectra.
     Calibrate(calibrate::CalibrateArgs),
@@ -156,6 +160,7 @@ pub fn main() -> ExitCode {
         Command::Replay(args) => replay::run(&args),
         Command::Import(args) => import::run(&args),
         Command::Simulate(args) => simulate::run(&args),
+        Command::Dataset(args) => dataset::run(&args),
         Command::Trend(args) => trend::run(&args),
         Command::Evaluate(args) => evaluate::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),

@@ -5,6 +5,7 @@
 mod alerts;
 mod cli;
 mod daemon;
+mod dataset;
 mod developer_set;
 mod envelope;
 mod fleet;
