@@ -38,15 +38,16 @@
 //!   the reader (the writer is a sink, the replay a source).
 //! - [`messages`]: the vocabulary every room above speaks: typed faults, flags, health stages,
 //!   speed sources and the pipeline's messages; MCAP and iceoryx2 encode them at the edge.
-//! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies.
+//! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies and the
+//!   fault kinds (from the `bearing-signal` crate, shared with `firmware-sim`).
 //! - [`random`]: seeded random numbers (ChaCha8), the same on every machine, for the simulator
-//!   and for tests at every level.
+//!   and for tests at every level (from `bearing-signal`).
 //! - [`clock`]: the one reading of the system clock, for the daemon's edges (sources, sinks).
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
 
 pub mod analysis;
-pub mod bearing;
+pub use bearing_signal::bearing;
 pub mod cli;
 pub mod clock;
 pub mod config;
@@ -59,7 +60,7 @@ pub mod messages;
 pub mod offline;
 pub mod pipeline;
 pub mod plot;
-pub mod random;
+pub use bearing_signal::random;
 pub mod recording;
 pub mod report;
 pub mod sinks;

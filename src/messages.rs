@@ -15,7 +15,6 @@
 //! integers the sensor sent plus its scale), everything else as JSON (low rate, readable
 //! anywhere).
 
-use crate::bearing::FaultFrequencies;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -31,70 +30,7 @@ macro_rules! display_as_name {
     )*};
 }
 
-/// The fault classes that have a characteristic frequency.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
-)]
-#[serde(rename_all = "snake_case")]
-pub enum FaultKind {
-    OuterRace,
-    InnerRace,
-    Ball,
-    Cage,
-}
-
-impl FaultKind {
-    pub const ALL: [FaultKind; 4] = [
-        FaultKind::OuterRace,
-        FaultKind::InnerRace,
-        FaultKind::Ball,
-        FaultKind::Cage,
-    ];
-
-    /// The wire name: `outer_race`, `inner_race`, `ball`, `cage`.
-    pub fn name(self) -> &'static str {
-        match self {
-            FaultKind::OuterRace => "outer_race",
-            FaultKind::InnerRace => "inner_race",
-            FaultKind::Ball => "ball",
-            FaultKind::Cage => "cage",
-        }
-    }
-
-    /// Position in [`FaultKind::ALL`] (the order of every per-fault array).
-    pub fn index(self) -> usize {
-        self as usize
-    }
-
-    /// The short label engineers use for the frequency: BPFO, BPFI, 2BSF (twice the ball spin frequency), FTF.
-    pub fn frequency_label(self) -> &'static str {
-        match self {
-            FaultKind::OuterRace => "BPFO",
-            FaultKind::InnerRace => "BPFI",
-            FaultKind::Ball => "2BSF",
-            FaultKind::Cage => "FTF",
-        }
-    }
-
-    /// The repetition frequency of this fault's impacts.
-    pub fn frequency(self, f: &FaultFrequencies) -> f64 {
-        match self {
-            FaultKind::OuterRace => f.bpfo,
-            FaultKind::InnerRace => f.bpfi,
-            FaultKind::Ball => f.two_bsf,
-            FaultKind::Cage => f.ftf,
-        }
-    }
-
-    /// The modulation that makes sidebands around this fault's harmonics, if any.
-    pub fn sideband_spacing(self, f: &FaultFrequencies) -> Option<f64> {
-        match self {
-            FaultKind::InnerRace => Some(f.shaft),
-            FaultKind::Ball => Some(f.ftf),
-            FaultKind::OuterRace | FaultKind::Cage => None,
-        }
-    }
-}
+pub use crate::bearing::FaultKind;
 
 /// A fault flag's level: `ok | watch | alarm`, ordered by severity.
 #[derive(
@@ -248,14 +184,7 @@ impl IsoZone {
     }
 }
 
-display_as_name!(
-    FaultKind,
-    FlagLevel,
-    HealthStage,
-    HealthKind,
-    SpeedSource,
-    IsoZone
-);
+display_as_name!(FlagLevel, HealthStage, HealthKind, SpeedSource, IsoZone);
 
 /// Identifies one analysed signal: a sensor (node) and one of its axes.
 #[derive(

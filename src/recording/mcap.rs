@@ -17,9 +17,6 @@ use crate::messages::PipelineMessage;
 use std::collections::BTreeSet;
 use std::path::Path;
 
-/// The first bytes of every MCAP file.
-pub(super) const MAGIC: &[u8] = ::mcap::MAGIC;
-
 /// Most samples of one channel kept (2^24: 11 minutes at 25.6 kHz, 128 MiB): `analyze` holds
 /// the record in memory. Longer logs are analysed over their first part, with a warning.
 const MAX_SAMPLES: usize = 1 << 24;

@@ -9,7 +9,7 @@ pub mod hw;
 pub mod model;
 pub mod optimize;
 pub mod physics;
-pub mod simulate;
+pub use bearing_signal::simulate;
 
 pub use fit::{FitBounds, HypothesisFit, TwinFitter, TwinParams};
 pub use simulate::{Nuisance, SimulatedFault, SimulationParams, Simulator};

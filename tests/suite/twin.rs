@@ -2,7 +2,7 @@
 //! and on real CWRU records the right hypothesis wins with a small envelope-spectrum error.
 
 use bearingd::analysis::envelope::FftPlans;
-use bearingd::analysis::Band;
+use bearingd::analysis::{analyze_record, AnalysisSettings, Band};
 use bearingd::messages::FaultKind;
 use bearingd::offline::{analyze, AnalyzeRequest};
 use bearingd::twin::diagnose::fit_record;
@@ -129,4 +129,32 @@ fn on_cwru_the_right_twin_wins_with_a_small_error() {
         mean <= 0.30,
         "mean envelope-spectrum error {mean:.3} > 0.30: {errors:?}"
     );
+}
+
+/// The simulator's cage fault, seen by the analysis (moved here with the simulator into the
+/// bearing-signal crate, which knows no analysis).
+#[test]
+fn a_cage_fault_shows_at_ftf_and_not_as_a_race_or_ball_fault() {
+    let params = SimulationParams {
+        noise_g: 0.05,
+        ..SimulationParams::example(SimulatedFault::Cage)
+    };
+    let signal = Simulator::record(params.clone(), 10.0);
+    let analysis = analyze_record(
+        &signal,
+        params.fs_hz,
+        &params.frequencies(),
+        &AnalysisSettings::default(),
+    )
+    .unwrap();
+    let cage = analysis.score(FaultKind::Cage);
+    for kind in [FaultKind::OuterRace, FaultKind::InnerRace, FaultKind::Ball] {
+        assert!(
+            cage > 2.0 * analysis.score(kind),
+            "cage {cage:.1} vs {} {:.1}",
+            kind.name(),
+            analysis.score(kind)
+        );
+    }
+    assert!(cage > 5.0, "cage score {cage:.1}");
 }

@@ -11,11 +11,11 @@
 mod pacing;
 mod transport;
 
+use bearing_signal::recording::{read_recording, ReadOptions};
+use bearing_signal::simulate::{SimulatedFault, SimulationParams, Simulator};
 use bearing_wire::{
     encode, AxisSet, FirmwareVersion, FrameKind, NodeConfig, SensorNode, SpeedSource,
 };
-use bearingd::recording::{read_recording, ReadOptions};
-use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 use clap::{Parser, ValueEnum};
 use pacing::{BusPacer, SampleClock};
 use std::collections::BTreeMap;

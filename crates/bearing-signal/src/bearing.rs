@@ -4,6 +4,7 @@
 //! Why here and not in the config: the catalog and the equations are used by `analyze`, the
 //! twin and the daemon alike; the config only names a bearing or gives custom geometry.
 
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -328,5 +329,76 @@ mod tests {
     fn custom_geometry_accepts_inches() {
         let b = BearingGeometry::parse("z=9,d=0.3126in,D=1.537in,alpha=0").unwrap();
         assert!((b.element_diameter_mm - 7.94).abs() < 0.01);
+    }
+}
+
+/// The fault classes that have a characteristic frequency.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum FaultKind {
+    OuterRace,
+    InnerRace,
+    Ball,
+    Cage,
+}
+
+impl FaultKind {
+    pub const ALL: [FaultKind; 4] = [
+        FaultKind::OuterRace,
+        FaultKind::InnerRace,
+        FaultKind::Ball,
+        FaultKind::Cage,
+    ];
+
+    /// The wire name: `outer_race`, `inner_race`, `ball`, `cage`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FaultKind::OuterRace => "outer_race",
+            FaultKind::InnerRace => "inner_race",
+            FaultKind::Ball => "ball",
+            FaultKind::Cage => "cage",
+        }
+    }
+
+    /// Position in [`FaultKind::ALL`] (the order of every per-fault array).
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    /// The short label engineers use for the frequency: BPFO, BPFI, 2BSF (twice the ball spin frequency), FTF.
+    pub fn frequency_label(self) -> &'static str {
+        match self {
+            FaultKind::OuterRace => "BPFO",
+            FaultKind::InnerRace => "BPFI",
+            FaultKind::Ball => "2BSF",
+            FaultKind::Cage => "FTF",
+        }
+    }
+
+    /// The repetition frequency of this fault's impacts.
+    pub fn frequency(self, f: &FaultFrequencies) -> f64 {
+        match self {
+            FaultKind::OuterRace => f.bpfo,
+            FaultKind::InnerRace => f.bpfi,
+            FaultKind::Ball => f.two_bsf,
+            FaultKind::Cage => f.ftf,
+        }
+    }
+
+    /// The modulation that makes sidebands around this fault's harmonics, if any.
+    pub fn sideband_spacing(self, f: &FaultFrequencies) -> Option<f64> {
+        match self {
+            FaultKind::InnerRace => Some(f.shaft),
+            FaultKind::Ball => Some(f.ftf),
+            FaultKind::OuterRace | FaultKind::Cage => None,
+        }
+    }
+}
+
+impl fmt::Display for FaultKind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
     }
 }
