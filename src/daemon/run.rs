@@ -45,7 +45,9 @@ use crate::sinks::alerts::PublisherSummary;
 use crate::sinks::fleet::FleetSink;
 use crate::sinks::mcap::McapSink;
 use crate::sinks::systemd::{keep_alive, status_text, Notifier};
-use crate::sources::live::{can_interfaces, forward, shm_sensors, SENSOR_TIMEOUT};
+use crate::sources::live::{can_interfaces, shm_sensors};
+#[cfg(any(feature = "can", feature = "shm"))]
+use crate::sources::live::{forward, SENSOR_TIMEOUT};
 use crate::sources::sim::SimSource;
 use crate::sources::Arrived;
 use std::collections::BTreeMap;
@@ -598,7 +600,7 @@ fn start_live_sources(
     #[cfg_attr(not(any(feature = "can", feature = "shm")), allow(unused_mut))]
     let mut any = false;
     // Each source's counters go to the log (`/ingest/<source>`) at the status interval.
-    #[cfg_attr(not(any(feature = "can", feature = "shm")), allow(unused_variables))]
+    #[cfg_attr(not(feature = "shm"), allow(unused_variables))]
     let status_interval = Duration::from_secs_f64(config.outputs.status_interval_s);
     #[cfg_attr(not(any(feature = "can", feature = "shm")), allow(unused_variables))]
     let stopped = |mut stop: watch::Receiver<bool>| async move {
