@@ -55,9 +55,9 @@ pub struct Baseline {
 /// `baselines.json` holds and what a log's `bearingd.state` record carries.
 pub fn baselines_to_json(
     baselines: &std::collections::BTreeMap<crate::messages::ChannelId, Baseline>,
-) -> String {
+) -> Result<String, serde_json::Error> {
     let list: Vec<_> = baselines.iter().collect();
-    serde_json::to_string_pretty(&list).unwrap_or_else(|_| "[]".to_string())
+    serde_json::to_string_pretty(&list)
 }
 
 /// Reads what [`baselines_to_json`] wrote.

@@ -299,20 +299,44 @@ fn print_text(summary: &ReplaySummary, out: &Path) {
     );
 }
 
+/// Where a replayed run's starting health baselines came from, for stderr.
+fn baselines_said(run: &RunStart) -> String {
+    match run.baselines_from {
+        BaselinesFrom::Log => format!(
+            "from the {} channel baseline(s) the daemon loaded then (the log's record)",
+            run.baselines.len()
+        ),
+        BaselinesFrom::PreviousRun => "from the baselines the run before reached (the log does \
+                                       not record what the daemon loaded)"
+            .to_string(),
+        BaselinesFrom::None => "learning its baselines from scratch".to_string(),
+        BaselinesFrom::UnreadableRecord => format!(
+            "{}: the log's bearingd.state record does not read",
+            if run.baselines.is_empty() {
+                "learning its baselines from scratch"
+            } else {
+                "from the baselines the run before reached"
+            }
+        ),
+    }
+}
+
 /// Run boundaries, gaps, missing files and what could not be read, on stderr.
 fn report_boundaries_and_losses(summary: &ReplaySummary, plan: &ReplayPlan) {
+    if let Some(first) = summary
+        .runs
+        .first()
+        .filter(|r| r.baselines_from == BaselinesFrom::UnreadableRecord)
+    {
+        eprintln!(
+            "bearingd: replay: {}: {}",
+            first.first_file.display(),
+            baselines_said(first)
+        );
+    }
     for pair in summary.runs.windows(2) {
         let (before, after) = (&pair[0], &pair[1]);
-        let baselines = match after.baselines_from {
-            BaselinesFrom::Log => format!(
-                "from the {} channel baseline(s) the daemon loaded then (the log's record)",
-                after.baselines.len()
-            ),
-            BaselinesFrom::PreviousRun => "from the baselines the run before reached (the log \
-                                           does not record what the daemon loaded)"
-                .to_string(),
-            BaselinesFrom::None => "learning its baselines from scratch".to_string(),
-        };
+        let baselines = baselines_said(after);
         eprintln!(
             "bearingd: replay: run boundary at {}: run {} (sample 0 at {}) follows run {}: the \
              daemon restarted (a crash or a stop); the pipeline starts again, {baselines}",

@@ -65,6 +65,8 @@ pub enum BaselinesFrom {
     PreviousRun,
     /// No record and no run before: learned from scratch.
     None,
+    /// The run's record does not read (said, never silent): as without a record.
+    UnreadableRecord,
 }
 
 impl BaselinesFrom {
@@ -73,14 +75,12 @@ impl BaselinesFrom {
         run: &PlannedRun,
         reached: Option<&BTreeMap<ChannelId, Baseline>>,
     ) -> (BaselinesFrom, BTreeMap<ChannelId, Baseline>) {
-        let logged = run
-            .start_baselines_json
-            .as_deref()
-            .and_then(|json| baselines_from_json(json).ok());
-        match (logged, reached) {
-            (Some(logged), _) => (BaselinesFrom::Log, logged),
-            (None, Some(reached)) => (BaselinesFrom::PreviousRun, reached.clone()),
-            (None, None) => (BaselinesFrom::None, BTreeMap::new()),
+        let otherwise = || reached.cloned().unwrap_or_default();
+        match run.start_baselines_json.as_deref().map(baselines_from_json) {
+            Some(Ok(logged)) => (BaselinesFrom::Log, logged),
+            Some(Err(_)) => (BaselinesFrom::UnreadableRecord, otherwise()),
+            None if reached.is_some() => (BaselinesFrom::PreviousRun, otherwise()),
+            None => (BaselinesFrom::None, BTreeMap::new()),
         }
     }
 }
@@ -301,7 +301,8 @@ impl<'a> RunReplay<'a> {
                 .unwrap_or(0),
             first_file: self.first_file.clone(),
             baselines_from: self.baselines_from,
-            baselines: self.start_baselines.clone(),
+            // The pipeline holds its own copy since it was made; this one goes to the sinks.
+            baselines: std::mem::take(&mut self.start_baselines),
         };
         self.sinks = Some(open_sinks(&start)?);
         summary.runs.push(start);

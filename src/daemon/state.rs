@@ -79,7 +79,7 @@ pub fn save_baselines(
     let path = state_dir.join(BASELINES_FILE);
     let temporary = state_dir.join(format!("{BASELINES_FILE}.new"));
     let write = || -> std::io::Result<()> {
-        let text = baselines_to_json(baselines);
+        let text = baselines_to_json(baselines).map_err(std::io::Error::other)?;
         let mut file = std::fs::File::create(&temporary)?;
         file.write_all(text.as_bytes())?;
         file.sync_all()?;

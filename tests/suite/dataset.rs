@@ -3,6 +3,7 @@
 //! diagnoses as its label says.
 
 use crate::cli::{bearingd, stderr};
+use crate::replay::replay_json;
 use bearingd_testdata::{mcap_files, python_scipy, scratch_dir};
 use std::path::Path;
 use std::process::Command;
@@ -99,17 +100,9 @@ fn a_dataset_is_read_by_numpy_the_same_twice_and_each_record_replays_as_labelled
     // nothing else, the healthy ones nothing.
     for (index, expected) in [(0, None), (2, Some("outer_race")), (4, Some("inner_race"))] {
         let log = mcap_files(&first.join(format!("mcap/{index:05}")));
-        let replayed = bearingd(&[
-            "replay",
-            log[0].to_str().unwrap(),
-            "--quiet",
-            "--json",
-            "--out",
-            dir.join(format!("replay-{index}")).to_str().unwrap(),
-        ]);
-        assert!(replayed.status.success(), "{}", stderr(&replayed));
-        let summary: serde_json::Value = serde_json::from_slice(&replayed.stdout).unwrap();
+        let (summary, _) = replay_json(&log, &dir.join(format!("replay-{index}")), &[]);
         assert_eq!(summary["settings_from"], "log", "{summary}");
+        assert_eq!(summary["samples"], 96_000, "{summary}");
         let raised: Vec<&str> = summary["flags"]
             .as_array()
             .unwrap()

@@ -91,7 +91,8 @@ fn python_metadata(py: &Path, file: &Path) -> serde_json::Value {
     serde_json::from_slice(&out.stdout).unwrap()
 }
 
-fn replay_json(files: &[PathBuf], out: &Path, extra: &[&str]) -> (serde_json::Value, String) {
+/// `bearingd replay --quiet --json` of `files` into `out`; it must succeed. (Summary, stderr.)
+pub fn replay_json(files: &[PathBuf], out: &Path, extra: &[&str]) -> (serde_json::Value, String) {
     let mut args = vec![
         "replay",
         "--out",
@@ -461,8 +462,65 @@ fn the_replay_of_a_restarted_run_starts_from_the_baselines_the_daemon_loaded() {
     assert_eq!(summary["runs"][0]["baselines_from"], "log", "{summary}");
     let live = logged_health(&second_run);
     let replayed = logged_health(&mcap_files(&dir.join("replay")));
+    assert!(
+        !live.is_empty(),
+        "the restarted run logged no health message"
+    );
     assert_eq!(replayed, live);
     // The replay's own log records the same starting state.
     let again = read_header(&mcap_files(&dir.join("replay"))[0]).unwrap();
     assert_eq!(again.start_baselines_json.as_deref(), Some(logged.as_str()));
+}
+
+/// A `bearingd.state` record that does not read is said on stderr and in `--json`, and the run
+/// learns its baselines, never silently as if the record were fine or absent.
+#[test]
+fn a_state_record_that_does_not_read_is_said_and_the_run_learns_from_scratch() {
+    use bearingd::config::Config;
+    use bearingd::messages::{ChannelId, RawBlock};
+    use bearingd::sinks::mcap::metadata::run_records;
+    use bearingd::sinks::mcap::{LoggerConfig, McapLogger};
+    let dir = scratch_dir("replay-bad-state");
+    let config = Config::default_embedded().unwrap();
+    let fs = config.sensors[0].sample_rate_hz;
+    let origin = 1_700_000_000_000_000_000u64;
+    let mut metadata = run_records(&config, origin, origin, &Default::default());
+    let state = metadata
+        .iter_mut()
+        .find(|(name, _)| name == "bearingd.state")
+        .expect("a bearingd.state record");
+    state.1.insert("baselines_json".into(), "[[\"cut".into());
+    let logger_config = LoggerConfig {
+        metadata,
+        ..LoggerConfig::new(dir.join("log"))
+    };
+    let mut logger = McapLogger::create(logger_config, origin).unwrap();
+    let block = (fs / 10.0) as u64;
+    for k in 0..20u64 {
+        let raw = PipelineMessage::Raw(RawBlock {
+            channel: ChannelId {
+                sensor: config.sensors[0].id.clone(),
+                axis: config.sensors[0].axes[0].clone(),
+            },
+            first_sample: k * block,
+            sample_rate_hz: fs,
+            scale_g_per_count: 1e-4,
+            counts: vec![0; block as usize],
+        });
+        let at = origin + k * 100_000_000;
+        logger.log(&raw, at, at).unwrap();
+    }
+    logger.finish().unwrap();
+    let (summary, stderr) = replay_json(&mcap_files(&dir.join("log")), &dir.join("out"), &[]);
+    assert_eq!(summary["settings_from"], "log", "{summary}");
+    assert_eq!(summary["samples"], 20 * block, "{summary}");
+    assert_eq!(
+        summary["runs"][0]["baselines_from"], "unreadable_record",
+        "{summary}"
+    );
+    assert!(
+        stderr.contains("bearingd.state record does not read")
+            && stderr.contains("learning its baselines from scratch"),
+        "{stderr}"
+    );
 }

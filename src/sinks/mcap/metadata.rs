@@ -71,7 +71,10 @@ pub fn run_records(
     records.push(record(
         STATE_RECORD,
         [
-            ("baselines_json", baselines_to_json(baselines)),
+            (
+                "baselines_json",
+                baselines_to_json(baselines).unwrap_or_else(|e| format!("unserialisable: {e}")),
+            ),
             ("channels", baselines.len().to_string()),
         ],
     ));

@@ -126,8 +126,6 @@ pub struct McapSink {
     last_ns: u64,
     /// Log time of the last flush that reached the file.
     flushed_ns: u64,
-    /// Log time of the last flush forced to the disk: what survives a power cut.
-    synced_ns: u64,
     errors: Vec<McapLogError>,
     pub messages: u64,
     state: CurrentState,
@@ -161,7 +159,6 @@ impl McapSink {
                 next_sync_ns,
                 last_ns: origin_ns,
                 flushed_ns: origin_ns,
-                synced_ns: origin_ns,
                 errors: Vec::new(),
                 messages: 0,
                 state: CurrentState::default(),
@@ -217,16 +214,6 @@ impl McapSink {
 
     pub fn current_path(&self) -> Option<&Path> {
         self.logger.as_ref().and_then(|l| l.current_path())
-    }
-
-    /// Log time up to which the log survives a crash of the process (the last flush).
-    pub fn flushed_until_ns(&self) -> u64 {
-        self.flushed_ns
-    }
-
-    /// Log time up to which the log survives a power cut (the last fsync).
-    pub fn synced_until_ns(&self) -> u64 {
-        self.synced_ns
     }
 
     /// The open logger's counters (`None` once finished).
@@ -500,12 +487,7 @@ impl McapSink {
                 logger.flush()
             };
             match done {
-                Ok(()) => {
-                    self.flushed_ns = self.last_ns;
-                    if sync {
-                        self.synced_ns = self.last_ns;
-                    }
-                }
+                Ok(()) => self.flushed_ns = self.last_ns,
                 Err(e) => self.pause(&e, time),
             }
         }
@@ -553,19 +535,29 @@ mod tests {
         let rates = HashMap::from([("s".to_string(), 1000.0)]);
         let origin = 1_700_000_000_000_000_000;
         let (mut sink, _) = McapSink::open(config, rates, origin).unwrap();
-        // 20 s of data, a message every 100 ms (100 samples at 1 kHz).
-        for k in 1..=200 {
-            sink.write(&health_at(k * 100));
-        }
-        let stats = sink.log_stats().unwrap();
-        // Flushed every second of data, forced to the disk every third second.
-        assert_eq!(stats.flushes, 20, "{stats:?}");
+        // 20 s of data, a message every 100 ms (100 samples at 1 kHz); after each message,
+        // (flushes, fsyncs) so far.
+        let counts: Vec<(u64, u64)> = (1..=200)
+            .map(|k| {
+                sink.write(&health_at(k * 100));
+                let stats = sink.log_stats().unwrap();
+                (stats.flushes, stats.syncs)
+            })
+            .collect();
+        // Flushed at every whole second of data, forced to the disk at every third.
+        assert_eq!(counts[199], (20, 6), "fsyncs at 3, 6, 9, 12, 15, 18 s");
         assert_eq!(
-            stats.syncs, 6,
-            "fsyncs at 3, 6, 9, 12, 15, 18 s of data: {stats:?}"
+            counts[28],
+            (2, 0),
+            "2.9 s: flushed at 1 and 2 s, no fsync yet"
         );
-        assert_eq!(sink.flushed_until_ns() - origin, 20_000_000_000);
-        assert_eq!(sink.synced_until_ns() - origin, 18_000_000_000);
+        assert_eq!(
+            counts[29],
+            (3, 1),
+            "3.0 s: the first fsync, with the third flush"
+        );
+        assert_eq!(counts[58], (5, 1));
+        assert_eq!(counts[59], (6, 2));
         sink.finish().unwrap();
     }
 }
