@@ -1,7 +1,8 @@
 //! Hammerstein–Wiener identification time (issue 13): the seed's configuration (order 0,
 //! inputs a⁽¹⁾…a⁽³⁾, 3 poles, 0 zeros, delay 1, cubic output) on one PRONOSTIA snapshot
 //! (2,560 samples, 0.1 s at 25.6 kHz) and on 1 s at 25.6 kHz (ten snapshots of the same
-//! bearing joined end to end). Needs ../shared/data/femto.
+//! bearing joined end to end), and on the snapshot warm-started from an earlier snapshot's model
+//! (the daemon's periodic re-fit). Needs ../shared/data/femto.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::recording::{read_recording, ReadOptions};
@@ -28,6 +29,13 @@ fn identification(c: &mut Criterion) {
         let config = HwConfig::for_order(order);
         group.bench_function(format!("snapshot_2560_order{order}"), |b| {
             b.iter(|| identify_record(&short, FS_HZ, &config, None).unwrap())
+        });
+        // The daemon's re-fit: warm-started from the model of an earlier snapshot.
+        let earlier = identify_record(&snapshot(11), FS_HZ, &config, None)
+            .unwrap()
+            .model;
+        group.bench_function(format!("snapshot_2560_order{order}_warm"), |b| {
+            b.iter(|| identify_record(&short, FS_HZ, &config, Some(&earlier)).unwrap())
         });
         group.bench_function(format!("one_second_25600_order{order}"), |b| {
             b.iter(|| identify_record(&long, FS_HZ, &config, None).unwrap())

@@ -6,6 +6,7 @@ use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisSettings, BandSelection};
 use crate::offline::{analyze, AnalyzeRequest};
 use crate::report::{analysis_figure, render_text, AnalyzeReport};
+use crate::twin::hw::StateFilter;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
 
@@ -75,6 +76,26 @@ pub struct AnalyzeArgs {
     /// directory (bearing).
     #[arg(long, conflicts_with_all = ["demo", "twin", "plot"])]
     hw: bool,
+    /// With --hw: where the median filter sits in the virtual states' chain of differences,
+    /// raw_once (the raw signal, once: the seed's reading) or each_order (every order's
+    /// output on its own); docs/HW.md compares them.
+    #[arg(long, value_enum, default_value = "raw-once", requires = "hw")]
+    hw_states: HwStatesArg,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum HwStatesArg {
+    RawOnce,
+    EachOrder,
+}
+
+impl From<HwStatesArg> for StateFilter {
+    fn from(arg: HwStatesArg) -> Self {
+        match arg {
+            HwStatesArg::RawOnce => StateFilter::RawOnce,
+            HwStatesArg::EachOrder => StateFilter::EachOrder,
+        }
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -99,7 +120,7 @@ fn severity_from(args: &AnalyzeArgs) -> SeveritySettings {
 
 pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
     if args.hw {
-        return super::hw_table::run(&args.files, &args.recording);
+        return super::hw_table::run(&args.files, &args.recording, args.hw_states.into());
     }
     let settings = settings_from(args)?;
     let files: Vec<Option<PathBuf>> = if args.demo {

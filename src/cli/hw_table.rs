@@ -7,7 +7,7 @@
 
 use super::{CliError, RecordingArgs};
 use crate::recording::read_recording;
-use crate::twin::hw::{identify_record, HwConfig};
+use crate::twin::hw::{identify_record, HwConfig, StateFilter};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -18,7 +18,11 @@ const ORDERS: std::ops::RangeInclusive<usize> = 0..=9;
 /// One record: per order, (simulation accuracy %, one-step accuracy %, milliseconds).
 type RecordResult = Vec<(f64, f64, f64)>;
 
-pub fn run(files: &[PathBuf], recording: &RecordingArgs) -> Result<(), CliError> {
+pub fn run(
+    files: &[PathBuf],
+    recording: &RecordingArgs,
+    states: StateFilter,
+) -> Result<(), CliError> {
     let mut by_bearing: BTreeMap<String, Vec<RecordResult>> = BTreeMap::new();
     let mut failures = 0;
     println!(
@@ -30,7 +34,7 @@ pub fn run(files: &[PathBuf], recording: &RecordingArgs) -> Result<(), CliError>
     );
     println!("|---|{}", "---|".repeat(ORDERS.count()));
     for (done, file) in files.iter().enumerate() {
-        match record(file, recording) {
+        match record(file, recording, states) {
             Ok(result) => {
                 println!(
                     "| {} | {} |",
@@ -51,6 +55,8 @@ pub fn run(files: &[PathBuf], recording: &RecordingArgs) -> Result<(), CliError>
         eprint!("\r{}/{} records", done + 1, files.len());
     }
     eprintln!();
+    println!();
+    println!("Virtual states: median filter {}.", states.name());
     println!();
     println!("Mean per bearing (simulation accuracy 100·(1 − NRMSE) %; one-step in brackets; mean identification time):");
     println!();
@@ -88,7 +94,7 @@ pub fn run(files: &[PathBuf], recording: &RecordingArgs) -> Result<(), CliError>
 }
 
 /// Identifies every order on one record, timing each identification.
-fn record(file: &Path, args: &RecordingArgs) -> Result<RecordResult, String> {
+fn record(file: &Path, args: &RecordingArgs, states: StateFilter) -> Result<RecordResult, String> {
     let recording = read_recording(file, &args.read_options()).map_err(|e| e.to_string())?;
     let fs_hz = args.fs.or(recording.fs_hz).ok_or_else(|| {
         format!(
@@ -99,7 +105,11 @@ fn record(file: &Path, args: &RecordingArgs) -> Result<RecordResult, String> {
     ORDERS
         .map(|order| {
             let started = Instant::now();
-            let fit = identify_record(&recording.samples, fs_hz, &HwConfig::for_order(order), None)
+            let config = HwConfig {
+                states,
+                ..HwConfig::for_order(order)
+            };
+            let fit = identify_record(&recording.samples, fs_hz, &config, None)
                 .map_err(|e| format!("{}: order {order}: {e}", file.display()))?;
             let ms = started.elapsed().as_secs_f64() * 1e3;
             Ok((fit.accuracy.simulation, fit.accuracy.one_step, ms))

@@ -15,7 +15,8 @@
 //! y[k] = h( Σᵢ Bᵢ(q)/Fᵢ(q) · q^{−nk} · uᵢ[k] ),   h(w) = c₀ + w + c₂w² + … + c_d·w^d
 //! ```
 //!
-//! - [`states`]: the virtual states (finite differences, median filter of width 5);
+//! - [`states`]: the virtual states (finite differences, median filter of width 5, where in
+//!   the chain set by [`StateFilter`]);
 //! - [`linear`]: one input's transfer function, its poles, the stability guard;
 //! - [`output`]: the output polynomial and its inverse;
 //! - [`model`]: the identified model, its free-run simulation and one-step prediction, the
@@ -34,7 +35,7 @@ pub mod states;
 
 pub use identify::{identify, HwFit};
 pub use model::{Accuracy, HwModel, Responses};
-pub use states::VirtualStates;
+pub use states::{StateFilter, VirtualStates};
 
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +44,9 @@ use serde::{Deserialize, Serialize};
 pub struct HwConfig {
     /// `n`: the output is the virtual state `a⁽ⁿ⁾`.
     pub order: usize,
+    /// Where the median filter sits in the chain of differences.
+    #[serde(default)]
+    pub states: StateFilter,
     /// Inputs `a⁽ⁿ⁺¹⁾ … a⁽ⁿ⁺ⁱⁿᵖᵘᵗˢ⁾`.
     pub inputs: usize,
     /// Poles of each input's transfer function (`nf`).
@@ -70,6 +74,7 @@ impl Default for HwConfig {
     fn default() -> Self {
         HwConfig {
             order: 0,
+            states: StateFilter::default(),
             inputs: 3,
             poles: 3,
             zeros: 0,
@@ -182,6 +187,7 @@ pub fn identify_record(
         fs_hz,
         config.order + config.inputs,
         config.min_samples(),
+        config.states,
     )?;
     identify(&states, config, warm)
 }
