@@ -20,7 +20,7 @@
 //!
 //! Sans-IO: the caller reads the files and says when each snapshot was taken.
 
-use crate::analysis::degradation::TrendFit;
+use crate::analysis::degradation::{TrendFit, HORIZON_SPANS};
 use crate::analysis::health::{HealthTracker, CONFIRM_WINDOWS};
 use crate::analysis::indicators::Indicators;
 use crate::analysis::record::RecordAnalyzer;
@@ -68,9 +68,6 @@ impl Default for LifeSettings {
         }
     }
 }
-
-/// How far ahead of the newest snapshot a crossing is looked for, in trend-window spans.
-const HORIZON_SPANS: f64 = 10.0;
 
 /// Fewest samples a snapshot must have.
 pub const MIN_SNAPSHOT_SAMPLES: usize = 256;
@@ -237,16 +234,11 @@ impl LifeTracker {
                 .max_by(|a, b| a.1.total_cmp(&b.1))
         });
 
-        let baseline = self.health.baseline();
         let stage = self.health.stage();
-        let sigma = self.settings.sigma;
-        let learned = |s: &crate::analysis::health::RunningStats| {
-            (s.count >= self.settings.baseline_snapshots.max(2)).then(|| s.mean + sigma * s.std())
-        };
         let kurtosis_limit = (stage != HealthStage::Learning)
-            .then(|| learned(&baseline.kurtosis))
+            .then(|| self.health.healthy_limit())
             .flatten();
-        let rms_limit = learned(&baseline.aging_rms);
+        let rms_limit = self.health.failure_limit();
         let threshold = match self.settings.threshold_rms {
             Some(given) => Some(given),
             None if stage >= HealthStage::Degrading => rms_limit,

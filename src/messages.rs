@@ -269,6 +269,89 @@ pub struct TwinMessage {
     pub residual: Vec<f32>,
 }
 
+/// The Hammerstein–Wiener model of seed 003 (docs/HW.md), re-identified with each twin fit on
+/// the last `twin.hw_samples` samples of the fit's signal, warm-started from the channel's
+/// previous model; its time residuals and its drift against the channel's healthy baseline.
+/// Topic `/hw/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct HwMessage {
+    pub channel: ChannelId,
+    /// One past the last sample of the twin fit's signal.
+    pub end_sample: u64,
+    /// Sample of the first residual value (the virtual states start here).
+    pub first_sample: u64,
+    pub fs_hz: f64,
+    /// Output state order `n` (the model predicts `a⁽ⁿ⁾` from `a⁽ⁿ⁺¹⁾…`).
+    pub order: usize,
+    /// Where the median filter sits in the states' chain: `raw_once` or `each_order`.
+    pub states: String,
+    /// Why no model was identified (a flat or too short signal); the other fields are then
+    /// empty or null.
+    pub problem: Option<String>,
+    /// Whether the identification started from the channel's previous model.
+    pub warm_start: bool,
+    /// Levenberg–Marquardt iterations taken.
+    pub iterations: usize,
+    /// `100·(1 − NRMSE)` of the free-run simulation, %.
+    pub accuracy_simulation: f64,
+    /// `100·(1 − NRMSE)` of the one-step-ahead prediction of the model's linear ARX part (the
+    /// identification's starting point), %.
+    pub accuracy_one_step: f64,
+    /// Per input `a⁽ⁿ⁺ⁱ⁾`: numerator `b₀…` and denominator `f₁…` (monic, `1 + f₁q⁻¹ + …`) of
+    /// its transfer function, on normalised signals.
+    pub numerators: Vec<Vec<f64>>,
+    pub denominators: Vec<Vec<f64>>,
+    /// Largest pole radius per input.
+    pub pole_radius: Vec<f64>,
+    /// Output polynomial `c₀, c₁ = 1, c₂, …`.
+    pub output_polynomial: Vec<f64>,
+    /// Normalisation of the output: `a⁽ⁿ⁾ = mean + scale · y`.
+    pub output_mean: f64,
+    pub output_scale: f64,
+    /// Measured minus simulated output per sample, in units of `output_scale`.
+    pub residual_simulation: Vec<f32>,
+    /// Measured minus the ARX part's one-step-ahead prediction per sample, in units of
+    /// `output_scale`.
+    pub residual_one_step: Vec<f32>,
+    /// Fits in the channel's healthy baseline so far (it is complete at `twin.hw_baseline_fits`).
+    pub baseline_fits: u64,
+    /// Free-run NRMSE (%) against its baseline, in baseline standard deviations; null while
+    /// the baseline is learned.
+    pub residual_drift_sigma: Option<f64>,
+    /// Distance of the parameters (numerators, denominators, polynomial) from their baseline
+    /// mean, relative to the mean's length; null while the baseline is learned.
+    pub parameter_drift: Option<f64>,
+}
+
+/// The channel's RMS trend with its health stage (issue 13 item 5), one point per
+/// `thresholds.trend_point_s` of sample time: the point (median window RMS of the span) and,
+/// once the bearing is degrading and the failure limit is learned, the exponential trend of
+/// the newest `thresholds.trend_points` points with the time it predicts to the limit and its
+/// uncertainty band (docs/HEALTH.md). Topic `/trend/<sensor>/<axis>`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct TrendMessage {
+    pub channel: ChannelId,
+    pub end_sample: u64,
+    pub stage: HealthStage,
+    /// The point: median window RMS over the span, g.
+    pub rms: f64,
+    /// Points in the fit's window.
+    pub points: usize,
+    /// The failure limit (g) the time is predicted for; null before it is known.
+    pub threshold: Option<f64>,
+    /// Growth rate of `ln RMS` per second; null without a fit.
+    pub rate_per_s: Option<f64>,
+    /// Time for the RMS to double at that rate, s; null when it is not growing.
+    pub doubling_s: Option<f64>,
+    /// Predicted time from now to the limit, s; with the band's earliest and latest; null when
+    /// not within the look-ahead (ten spans of the fitted window).
+    pub time_to_threshold_s: Option<f64>,
+    pub earliest_s: Option<f64>,
+    pub latest_s: Option<f64>,
+    /// Two-sided coverage of the band, e.g. 0.9.
+    pub confidence: f64,
+}
+
 /// A fault flag changed state. Topic `/flags/<sensor>/<axis>`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct FlagMessage {
@@ -378,6 +461,8 @@ pub enum PipelineMessage {
     Spectrum(SpectrumMessage),
     Indicators(IndicatorsMessage),
     Twin(TwinMessage),
+    Hw(HwMessage),
+    Trend(TrendMessage),
     Flag(FlagMessage),
     Health(HealthMessage),
     Ingest(IngestMessage),

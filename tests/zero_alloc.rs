@@ -122,6 +122,7 @@ fn a_monitor_takes_hops_and_speed_changes_without_allocating() {
         },
         // The velocity severity (ISO zones) and its flag run every half window too.
         severity: Some(bearingd::analysis::iso::SeveritySettings::default()),
+        trend: bearingd::analysis::monitor::TrendSettings::default(),
     };
     let mut monitor = ChannelMonitor::new(settings, params.frequencies(), None);
     let counts: Vec<i16> = Simulator::record(params, 20.0)

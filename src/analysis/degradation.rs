@@ -168,6 +168,123 @@ impl TrendFit {
     }
 }
 
+/// The daemon's trend of RMS (issue 13 item 5, published with the health stage): the window
+/// RMS values of each span of sample time become one point (their median, so a lone transient
+/// does not move it), and the newest `max_points` points are fitted by [`TrendFit`] against
+/// the failure limit once the bearing is degrading: the same fit `bearingd trend` draws.
+///
+/// Bounded and allocation-free per window: the span's values and the points live in buffers
+/// sized at construction; only the fit itself, once per span while degrading, allocates.
+#[derive(Debug, Clone)]
+pub struct RmsTrend {
+    span_samples: u64,
+    fs_hz: f64,
+    max_points: usize,
+    confidence: f64,
+    span: Vec<f64>,
+    span_capacity: usize,
+    span_ends_at: Option<u64>,
+    times: std::collections::VecDeque<f64>,
+    values: std::collections::VecDeque<f64>,
+}
+
+/// A new point of the trend.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrendPoint {
+    pub end_sample: u64,
+    /// The span's median window RMS.
+    pub rms: f64,
+    /// Points in the fit's window so far.
+    pub points: usize,
+    /// The fit and its threshold crossing; `None` without a threshold or with too few points.
+    pub fit: Option<TrendFit>,
+    /// Two-sided coverage of the fit's band.
+    pub confidence: f64,
+}
+
+impl RmsTrend {
+    /// One point per `span_s` of sample time at `fs_hz`, with at most `windows_per_span`
+    /// windows in a span (more are ignored: the span's first ones are kept), the newest
+    /// `max_points` points fitted with a band of two-sided coverage `confidence`.
+    pub fn new(
+        span_s: f64,
+        fs_hz: f64,
+        windows_per_span: usize,
+        max_points: usize,
+        confidence: f64,
+    ) -> Self {
+        let max_points = max_points.max(4);
+        RmsTrend {
+            span_samples: (span_s * fs_hz).round().max(1.0) as u64,
+            fs_hz,
+            max_points,
+            confidence,
+            span: Vec::with_capacity(windows_per_span.max(1)),
+            span_capacity: windows_per_span.max(1),
+            span_ends_at: None,
+            times: std::collections::VecDeque::with_capacity(max_points),
+            values: std::collections::VecDeque::with_capacity(max_points),
+        }
+    }
+
+    /// One window's RMS ending at `end_sample`; a point when a span is complete. `threshold`:
+    /// the RMS the crossing is predicted for (the failure limit), `None` before it is known.
+    pub fn push(
+        &mut self,
+        rms: f64,
+        end_sample: u64,
+        threshold: Option<f64>,
+    ) -> Option<TrendPoint> {
+        let ends_at = *self
+            .span_ends_at
+            .get_or_insert(end_sample + self.span_samples);
+        if rms.is_finite() && rms > 0.0 && self.span.len() < self.span_capacity {
+            self.span.push(rms);
+        }
+        if end_sample < ends_at {
+            return None;
+        }
+        self.span_ends_at = Some(end_sample + self.span_samples);
+        if self.span.is_empty() {
+            return None;
+        }
+        self.span.sort_unstable_by(f64::total_cmp);
+        let mid = self.span.len() / 2;
+        let median = if self.span.len() % 2 == 1 {
+            self.span[mid]
+        } else {
+            0.5 * (self.span[mid - 1] + self.span[mid])
+        };
+        self.span.clear();
+        if self.times.len() == self.max_points {
+            self.times.pop_front();
+            self.values.pop_front();
+        }
+        self.times.push_back(end_sample as f64 / self.fs_hz);
+        self.values.push_back(median);
+        let fit = threshold.and_then(|threshold| {
+            TrendFit::fit(
+                self.times.make_contiguous(),
+                self.values.make_contiguous(),
+                threshold,
+                self.confidence,
+                HORIZON_SPANS,
+            )
+        });
+        Some(TrendPoint {
+            end_sample,
+            rms: median,
+            points: self.times.len(),
+            fit,
+            confidence: self.confidence,
+        })
+    }
+}
+
+/// How far ahead of the newest point a crossing is looked for, in spans of the fitted window
+/// (`bearingd trend` looks as far).
+pub const HORIZON_SPANS: f64 = 10.0;
+
 /// The `p` quantile of Student's t with `df` degrees of freedom (`p` in [0.5, 1)): the normal
 /// quantile corrected by the Cornish–Fisher expansion (error below 1 % from 3 degrees of
 /// freedom on, which is far below the uncertainty it describes).
@@ -230,6 +347,41 @@ pub fn normal_quantile(p: f64) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use super::RmsTrend;
+
+    #[test]
+    fn the_daemon_trend_makes_a_point_per_span_from_the_median_and_predicts_the_crossing() {
+        // Windows every 0.5 s; RMS growing as e^{t/100}; one point per 10 s; limit 0.5 g.
+        let fs = 1000.0;
+        let mut trend = RmsTrend::new(10.0, fs, 22, 12, 0.9);
+        let mut points = Vec::new();
+        for w in 1..=300u64 {
+            let t = w as f64 * 0.5;
+            let mut rms = 0.1 * (t / 100.0).exp();
+            if w % 7 == 0 {
+                rms *= 50.0; // a lone transient: the median of its span drops it
+            }
+            let threshold = (t >= 60.0).then_some(0.5);
+            points.extend(trend.push(rms, (t * fs) as u64, threshold));
+        }
+        assert_eq!(points.len(), 14, "one point per 10 s after the first span");
+        assert!(points.iter().all(|p| p.points <= 12));
+        for p in &points {
+            let t = p.end_sample as f64 / fs;
+            let expected = 0.1 * ((t - 5.0) / 100.0).exp();
+            assert!((p.rms / expected - 1.0).abs() < 0.05, "{} at {t}", p.rms);
+        }
+        assert!(
+            points.iter().take(5).all(|p| p.fit.is_none()),
+            "no limit yet"
+        );
+        let last = points.last().unwrap().fit.unwrap();
+        // ln(0.5/0.1)·100 + 5 ≈ 166 s: the crossing predicted within a few seconds.
+        let crossing = last.crossing_s.unwrap();
+        assert!((crossing - 166.0).abs() < 5.0, "{crossing}");
+        assert!((last.rate_per_s - 0.01).abs() < 5e-4, "{}", last.rate_per_s);
+    }
+
     use super::*;
     use crate::random::Rng;
 

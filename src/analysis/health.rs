@@ -110,6 +110,21 @@ impl HealthTracker {
         &self.baseline
     }
 
+    /// The kurtosis above which the healthy stage is left, once the baseline is learned.
+    pub fn healthy_limit(&self) -> Option<f64> {
+        self.limit_of(&self.baseline.kurtosis)
+    }
+
+    /// The RMS above which the failure stage is entered, once the aging baseline (the first
+    /// windows of the degradation stage) is learned.
+    pub fn failure_limit(&self) -> Option<f64> {
+        self.limit_of(&self.baseline.aging_rms)
+    }
+
+    fn limit_of(&self, stats: &RunningStats) -> Option<f64> {
+        (stats.count >= self.baseline_windows).then(|| stats.mean + self.sigma * stats.std())
+    }
+
     /// Feeds one window's kurtosis and RMS.
     pub fn update(&mut self, kurtosis: f64, rms: f64, end_sample: u64) -> Option<StageChange> {
         if !(kurtosis.is_finite() && rms.is_finite()) {
@@ -127,16 +142,13 @@ impl HealthTracker {
                 self.confirmed(kurtosis > limit)
                     .then_some(HealthStage::Degrading)
             }
-            HealthStage::Degrading => {
-                if self.baseline.aging_rms.count < self.baseline_windows {
+            HealthStage::Degrading => match self.failure_limit() {
+                None => {
                     self.baseline.aging_rms.add(rms);
                     None
-                } else {
-                    let limit =
-                        self.baseline.aging_rms.mean + self.sigma * self.baseline.aging_rms.std();
-                    self.confirmed(rms > limit).then_some(HealthStage::Failing)
                 }
-            }
+                Some(limit) => self.confirmed(rms > limit).then_some(HealthStage::Failing),
+            },
             HealthStage::Failing => None,
         };
         next.map(|to| {

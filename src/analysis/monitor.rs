@@ -15,7 +15,8 @@
 //!   hypothesis) picks the fault whose score drives its flag; the others' flags see 0.
 //!   (choice) A second fault at the same time shows once it leads: this keeps one strong
 //!   fault's leakage into the other fault bands from raising false alarms.
-//! - Health: the stage tracker, fed with each window's kurtosis and RMS.
+//! - Health: the stage tracker, fed with each window's kurtosis and RMS, and the RMS trend
+//!   (one point per `trend.point_s`, fitted against the failure limit once degrading).
 //! - Sensor: clipping (counts at full scale) and a flat line (no change for a second) are
 //!   reported when they start and when they end.
 //! - Speed ([`SpeedMode`]): fixed, given from outside at a sample position (speed frames, or a
@@ -43,6 +44,7 @@
 use super::band_selection::{
     scaled, usable_shaft_hz, BandJob, BandResult, BandSelector, InlineSelector,
 };
+use super::degradation::{RmsTrend, TrendPoint};
 use super::diagnosis::{leader, Contest, Named};
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
@@ -54,7 +56,7 @@ use super::record::envelope_range_hz;
 use super::speed::SpeedSearch;
 use super::{AnalysisSettings, Band};
 use crate::bearing::FaultFrequencies;
-use crate::messages::{FaultKind, FlagLevel, HealthKind};
+use crate::messages::{FaultKind, FlagLevel, HealthKind, HealthStage};
 
 /// Everything a monitor needs, with durations already in samples.
 #[derive(Debug, Clone)]
@@ -85,6 +87,30 @@ pub struct MonitorSettings {
     pub speed: SpeedMode,
     /// The machine the velocity zones are judged for; `None`: no velocity analysis.
     pub severity: Option<SeveritySettings>,
+    /// The RMS trend published with the health stage.
+    pub trend: TrendSettings,
+}
+
+/// How the RMS trend is made ([`RmsTrend`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrendSettings {
+    /// Sample time per point (the median of its windows' RMS).
+    pub point_s: f64,
+    /// Points fitted (the newest).
+    pub points: usize,
+    /// Two-sided coverage of the band around the fit.
+    pub confidence: f64,
+}
+
+impl Default for TrendSettings {
+    /// A point a minute, the last 30 fitted, a 90 % band (`bearingd trend`'s coverage).
+    fn default() -> Self {
+        TrendSettings {
+            point_s: 60.0,
+            points: 30,
+            confidence: 0.9,
+        }
+    }
 }
 
 /// Where a channel's shaft speed comes from.
@@ -154,6 +180,11 @@ pub enum MonitorEvent<'a> {
         frequency_hz: f64,
     },
     Stage(StageChange),
+    /// A new point of the RMS trend, with the stage it was made in.
+    Trend {
+        point: TrendPoint,
+        stage: HealthStage,
+    },
     Sensor {
         condition: SensorCondition,
         active: bool,
@@ -207,6 +238,7 @@ pub struct ChannelMonitor {
     scorer: FaultScorer,
     flags: [FaultFlag; 4],
     health: HealthTracker,
+    trend: RmsTrend,
     scores: [FaultScore; 4],
     /// The others' scores with the leader explained away (the leader's own entry unused).
     explained: [FaultScore; 4],
@@ -307,6 +339,13 @@ impl ChannelMonitor {
                 settings.sigma,
                 CONFIRM_WINDOWS,
                 baseline,
+            ),
+            trend: RmsTrend::new(
+                settings.trend.point_s,
+                settings.fs_hz,
+                (settings.trend.point_s * settings.fs_hz / hop.max(1) as f64).ceil() as usize + 2,
+                settings.trend.points,
+                settings.trend.confidence,
             ),
             scores,
             explained: scores,
@@ -570,6 +609,7 @@ impl ChannelMonitor {
             scorer,
             flags,
             health,
+            trend,
             scores,
             explained,
             bands,
@@ -596,6 +636,13 @@ impl ChannelMonitor {
                 health.update(indicators.kurtosis, indicators.rms, update.end_sample)
             {
                 on_event(MonitorEvent::Stage(change));
+            }
+            let stage = health.stage();
+            let threshold = health
+                .failure_limit()
+                .filter(|_| stage >= HealthStage::Degrading);
+            if let Some(point) = trend.push(indicators.rms, update.end_sample, threshold) {
+                on_event(MonitorEvent::Trend { point, stage });
             }
             if *bands_known && speed_known {
                 // Only the leading fault feeds its flag (the verdict's rule); the others see 0

@@ -142,6 +142,10 @@ pub(crate) struct RawAnalysis {
 pub(crate) struct RawTwin {
     pub refit_period_s: Field<f64>,
     pub window_s: Field<f64>,
+    pub hw_enabled: Field<bool>,
+    pub hw_order: Field<i64>,
+    pub hw_samples: Field<i64>,
+    pub hw_baseline_fits: Field<i64>,
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -154,6 +158,8 @@ pub(crate) struct RawThresholds {
     pub off_delay_s: Field<f64>,
     pub baseline_windows: Field<i64>,
     pub sigma: Field<f64>,
+    pub trend_point_s: Field<f64>,
+    pub trend_points: Field<i64>,
 }
 
 #[derive(Debug, Default, Deserialize)]

@@ -220,6 +220,29 @@ pub struct TwinConfig {
     pub refit_period_s: f64,
     /// Length of signal each fit uses, in seconds.
     pub window_s: f64,
+    /// Whether the Hammerstein–Wiener model (seed 003) is re-identified with each fit.
+    #[serde(default = "default_hw_enabled")]
+    pub hw_enabled: bool,
+    /// Output state order of the HW model.
+    #[serde(default)]
+    pub hw_order: usize,
+    /// Newest samples of the fit's signal the HW model is identified on.
+    #[serde(default = "default_hw_samples")]
+    pub hw_samples: usize,
+    /// HW fits that form a channel's healthy baseline.
+    #[serde(default = "default_hw_baseline_fits")]
+    pub hw_baseline_fits: u64,
+}
+
+// Logs written before the HW keys existed read as the defaults.
+fn default_hw_enabled() -> bool {
+    true
+}
+fn default_hw_samples() -> usize {
+    2560
+}
+fn default_hw_baseline_fits() -> u64 {
+    10
 }
 
 impl Default for TwinConfig {
@@ -227,6 +250,10 @@ impl Default for TwinConfig {
         TwinConfig {
             refit_period_s: 10.0,
             window_s: 1.0,
+            hw_enabled: default_hw_enabled(),
+            hw_order: 0,
+            hw_samples: default_hw_samples(),
+            hw_baseline_fits: default_hw_baseline_fits(),
         }
     }
 }
@@ -249,6 +276,20 @@ pub struct ThresholdConfig {
     pub baseline_windows: usize,
     /// Standard deviations above the baseline that mark a change of health stage.
     pub sigma: f64,
+    /// Sample time per point of the RMS trend, in seconds.
+    #[serde(default = "default_trend_point_s")]
+    pub trend_point_s: f64,
+    /// Points of the RMS trend fitted (the newest).
+    #[serde(default = "default_trend_points")]
+    pub trend_points: usize,
+}
+
+// Logs written before the trend keys existed read as the defaults.
+fn default_trend_point_s() -> f64 {
+    60.0
+}
+fn default_trend_points() -> usize {
+    30
 }
 
 impl Default for ThresholdConfig {
@@ -261,6 +302,8 @@ impl Default for ThresholdConfig {
             off_delay_s: 30.0,
             baseline_windows: 30,
             sigma: 3.0,
+            trend_point_s: default_trend_point_s(),
+            trend_points: default_trend_points(),
         }
     }
 }

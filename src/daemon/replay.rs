@@ -226,7 +226,7 @@ impl<'a> RunReplay<'a> {
             source,
             pipeline,
             sinks: None,
-            worker: TwinWorker::default(),
+            worker: TwinWorker::new(&config.twin),
             next_sample: HashMap::new(),
             rates: config.sample_rates(),
             first_file: paths.first().cloned().unwrap_or_default(),
@@ -342,20 +342,21 @@ impl<'a> RunReplay<'a> {
         }
     }
 
-    /// One output of the pipeline: a message to every sink, a twin request fitted now.
+    /// One output of the pipeline: a message to every sink, a twin request fitted now (the
+    /// twin's fit, then the HW model's, as the daemon's re-fit thread hands them on).
     fn deliver(&mut self, output: Output, flags: &mut Vec<FlagMessage>) {
-        let message = match output {
-            Output::Message(message) => message,
-            Output::Twin(request) => match self.worker.refit(&request) {
-                Some(twin) => PipelineMessage::Twin(twin),
-                None => return,
-            },
+        let sinks = &mut self.sinks;
+        let mut write = |message: PipelineMessage| {
+            if let PipelineMessage::Flag(flag) = &message {
+                flags.push(flag.clone());
+            }
+            for sink in sinks.iter_mut().flatten() {
+                sink.write(&message);
+            }
         };
-        if let PipelineMessage::Flag(flag) = &message {
-            flags.push(flag.clone());
-        }
-        for sink in self.sinks.iter_mut().flatten() {
-            sink.write(&message);
+        match output {
+            Output::Message(message) => write(message),
+            Output::Twin(request) => self.worker.refit(&request, &mut write),
         }
     }
 }

@@ -21,8 +21,9 @@
 //! - alert thread: the iceoryx2 publisher of `outputs.alerts_service`
 //!   ([`crate::sinks::alerts`]). Alerts skip the sink queue so that MCAP compression never
 //!   delays them.
-//! - re-fit thread: [`TwinWorker`]; its fits go back to the analysis thread through a bounded
-//!   hand-over (one slot per channel, plus one; the re-fit thread waits when it is full), and
+//! - re-fit thread: [`TwinWorker`]; its fits (the twin's, then the HW model's) go back to the
+//!   analysis thread through a bounded hand-over (two slots per channel, plus two; the re-fit
+//!   thread waits when it is full), and
 //!   the analysis thread passes them on to the sinks, so that the sink queue has one producer.
 //! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
 //!   them at shutdown happens there.
@@ -38,7 +39,7 @@ use crate::analysis::health::Baseline;
 use crate::clock::wall_clock_now_ns;
 use crate::config::{Config, Transport};
 use crate::mcap_log::McapLogError;
-use crate::messages::{ChannelId, FlagMessage, PipelineMessage, TwinMessage};
+use crate::messages::{ChannelId, FlagMessage, PipelineMessage};
 use crate::pipeline::twin_queue::{twin_requests, TwinRequestQueue, TwinRequests};
 use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinWorker};
 use crate::sinks::alerts::PublisherSummary;
@@ -156,11 +157,13 @@ pub async fn run(
     let (input_tx, input_rx) = async_mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
     let (sink_tx, sink_rx) = mpsc::sync_channel::<PipelineMessage>(SINK_QUEUE);
     let (request_tx, request_rx) = twin_requests();
-    let (fit_tx, fit_rx) = mpsc::sync_channel::<TwinMessage>(config.channel_count() + 1);
+    // Two messages per request at most (the twin's fit, the HW model's).
+    let (fit_tx, fit_rx) = mpsc::sync_channel::<PipelineMessage>(2 * config.channel_count() + 2);
     let (status_tx, status_rx) = watch::channel(pipeline.status());
 
     let sink = spawn("sink", move || sink_thread(sinks, &sink_rx))?;
-    let refit = spawn("twin", move || refit_thread(&request_rx, &fit_tx))?;
+    let worker = TwinWorker::new(&config.twin);
+    let refit = spawn("twin", move || refit_thread(worker, &request_rx, &fit_tx))?;
     let analysis = AnalysisThread {
         pipeline,
         alerts,
@@ -388,7 +391,7 @@ struct AnalysisThread {
     sinks: mpsc::SyncSender<PipelineMessage>,
     /// `None` once the inputs have ended (closing the re-fit queue).
     twin_requests: Option<TwinRequests>,
-    fits: mpsc::Receiver<TwinMessage>,
+    fits: mpsc::Receiver<PipelineMessage>,
     status: watch::Sender<Vec<ChannelStatus>>,
     requests_skipped: u64,
     state_dir: PathBuf,
@@ -463,15 +466,17 @@ impl AnalysisThread {
         });
     }
 
-    /// A fit from the re-fit thread: into the channel's status and the alerts, then to the
-    /// sinks.
-    fn take_fit(&mut self, fit: TwinMessage) {
-        self.pipeline
-            .note_twin(&fit.channel, fit.hypothesis, fit.error);
-        if let Some(alerts) = self.alerts.as_mut() {
-            alerts.note_twin(&fit);
+    /// A message of the re-fit thread: a twin's fit into the channel's status and the alerts;
+    /// every one to the sinks.
+    fn take_fit(&mut self, fit: PipelineMessage) {
+        if let PipelineMessage::Twin(twin) = &fit {
+            self.pipeline
+                .note_twin(&twin.channel, twin.hypothesis, twin.error);
+            if let Some(alerts) = self.alerts.as_mut() {
+                alerts.note_twin(twin);
+            }
         }
-        let _ = self.sinks.send(PipelineMessage::Twin(fit));
+        let _ = self.sinks.send(fit);
     }
 
     /// The inputs have ended: the last fits, the baselines, the unknown channels, the alerts.
@@ -496,18 +501,23 @@ impl AnalysisThread {
     }
 }
 
-/// The re-fit thread: one request at a time, each fit handed back to the analysis thread.
-/// Returns the number of fits made.
-fn refit_thread(requests: &TwinRequestQueue, fits: &mpsc::SyncSender<TwinMessage>) -> u64 {
-    let mut worker = TwinWorker::default();
+/// The re-fit thread: one request at a time, each re-fit handed back to the analysis thread.
+/// Returns the number of twin fits made.
+fn refit_thread(
+    mut worker: TwinWorker,
+    requests: &TwinRequestQueue,
+    fits: &mpsc::SyncSender<PipelineMessage>,
+) -> u64 {
     let mut made = 0u64;
-    while let Some(request) = requests.take() {
-        if let Some(fit) = worker.refit(&request) {
-            made += 1;
-            if fits.send(fit).is_err() {
-                break;
-            }
-        }
+    let mut open = true;
+    while open {
+        let Some(request) = requests.take() else {
+            break;
+        };
+        worker.refit(&request, &mut |fit| {
+            made += u64::from(matches!(fit, PipelineMessage::Twin(_)));
+            open &= fits.send(fit).is_ok();
+        });
     }
     made
 }

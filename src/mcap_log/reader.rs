@@ -258,6 +258,8 @@ fn decode_json(kind: JsonKind, data: &[u8]) -> serde_json::Result<PipelineMessag
         JsonKind::Spectrum => PipelineMessage::Spectrum(serde_json::from_slice(data)?),
         JsonKind::Indicators => PipelineMessage::Indicators(serde_json::from_slice(data)?),
         JsonKind::Twin => PipelineMessage::Twin(serde_json::from_slice(data)?),
+        JsonKind::Hw => PipelineMessage::Hw(serde_json::from_slice(data)?),
+        JsonKind::Trend => PipelineMessage::Trend(serde_json::from_slice(data)?),
         JsonKind::Flag => PipelineMessage::Flag(serde_json::from_slice(data)?),
         JsonKind::Health => PipelineMessage::Health(serde_json::from_slice(data)?),
         JsonKind::Ingest => PipelineMessage::Ingest(serde_json::from_slice(data)?),

@@ -19,8 +19,9 @@ use prost_types::{
 use serde_json::{json, Value};
 
 use crate::messages::{
-    ChannelId, FlagMessage, HealthMessage, IndicatorsMessage, IngestMessage, PipelineMessage,
-    RawBlock, SpectrumMessage, SpeedMessage, TwinMessage, VelocityFlagMessage, VelocityMessage,
+    ChannelId, FlagMessage, HealthMessage, HwMessage, IndicatorsMessage, IngestMessage,
+    PipelineMessage, RawBlock, SpectrumMessage, SpeedMessage, TrendMessage, TwinMessage,
+    VelocityFlagMessage, VelocityMessage,
 };
 use schemars::generate::SchemaSettings;
 use schemars::transform::transform_subschemas;
@@ -146,6 +147,8 @@ pub enum JsonKind {
     Spectrum,
     Indicators,
     Twin,
+    Hw,
+    Trend,
     Flag,
     Health,
     Ingest,
@@ -155,10 +158,12 @@ pub enum JsonKind {
 }
 
 impl JsonKind {
-    pub const ALL: [JsonKind; 9] = [
+    pub const ALL: [JsonKind; 11] = [
         JsonKind::Spectrum,
         JsonKind::Indicators,
         JsonKind::Twin,
+        JsonKind::Hw,
+        JsonKind::Trend,
         JsonKind::Flag,
         JsonKind::Health,
         JsonKind::Ingest,
@@ -173,6 +178,8 @@ impl JsonKind {
             JsonKind::Spectrum => "bearingd.Spectrum",
             JsonKind::Indicators => "bearingd.Indicators",
             JsonKind::Twin => "bearingd.Twin",
+            JsonKind::Hw => "bearingd.Hw",
+            JsonKind::Trend => "bearingd.Trend",
             JsonKind::Flag => "bearingd.Flag",
             JsonKind::Health => "bearingd.Health",
             JsonKind::Ingest => "bearingd.Ingest",
@@ -199,6 +206,8 @@ impl JsonKind {
             JsonKind::Spectrum => generator.into_root_schema_for::<SpectrumMessage>(),
             JsonKind::Indicators => generator.into_root_schema_for::<IndicatorsMessage>(),
             JsonKind::Twin => generator.into_root_schema_for::<TwinMessage>(),
+            JsonKind::Hw => generator.into_root_schema_for::<HwMessage>(),
+            JsonKind::Trend => generator.into_root_schema_for::<TrendMessage>(),
             JsonKind::Flag => generator.into_root_schema_for::<FlagMessage>(),
             JsonKind::Health => generator.into_root_schema_for::<HealthMessage>(),
             JsonKind::Ingest => generator.into_root_schema_for::<IngestMessage>(),
@@ -341,6 +350,14 @@ pub fn encode(
             let _ = write!(topic, "/twin/{}/{}", m.channel.sensor, m.channel.axis);
             (JsonKind::Twin, serde_json::to_writer(&mut *payload, m))
         }
+        PipelineMessage::Hw(m) => {
+            let _ = write!(topic, "/hw/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Hw, serde_json::to_writer(&mut *payload, m))
+        }
+        PipelineMessage::Trend(m) => {
+            let _ = write!(topic, "/trend/{}/{}", m.channel.sensor, m.channel.axis);
+            (JsonKind::Trend, serde_json::to_writer(&mut *payload, m))
+        }
         PipelineMessage::Flag(m) => {
             let _ = write!(topic, "/flags/{}/{}", m.channel.sensor, m.channel.axis);
             (JsonKind::Flag, serde_json::to_writer(&mut *payload, m))
@@ -432,6 +449,44 @@ mod tests {
                 residual_peak_hz: 50.0,
                 residual_bin_hz: 0.5,
                 residual: vec![0.0],
+            }),
+            PipelineMessage::Hw(HwMessage {
+                channel: channel(),
+                end_sample: 25_600,
+                first_sample: 23_040,
+                fs_hz: 25_600.0,
+                order: 0,
+                states: "raw_once".into(),
+                problem: None,
+                warm_start: true,
+                iterations: 7,
+                accuracy_simulation: 93.5,
+                accuracy_one_step: f64::NAN,
+                numerators: vec![vec![0.1], vec![0.2], vec![0.3]],
+                denominators: vec![vec![-0.9, 0.1, 0.0]; 3],
+                pole_radius: vec![0.9; 3],
+                output_polynomial: vec![0.0, 1.0, 0.01, -0.001],
+                output_mean: 0.0,
+                output_scale: 0.2,
+                residual_simulation: vec![0.5, -0.25],
+                residual_one_step: vec![0.125, f32::NAN],
+                baseline_fits: 10,
+                residual_drift_sigma: Some(1.5),
+                parameter_drift: None,
+            }),
+            PipelineMessage::Trend(TrendMessage {
+                channel: channel(),
+                end_sample: 1_536_000,
+                stage: HealthStage::Degrading,
+                rms: 0.25,
+                points: 12,
+                threshold: Some(0.4),
+                rate_per_s: Some(1e-4),
+                doubling_s: Some(6931.5),
+                time_to_threshold_s: Some(4700.0),
+                earliest_s: Some(1200.0),
+                latest_s: None,
+                confidence: 0.9,
             }),
             PipelineMessage::Flag(FlagMessage {
                 channel: channel(),

@@ -23,7 +23,9 @@ pub use sink::{Sink, SinkError};
 
 use crate::analysis::flags::FlagSettings;
 use crate::analysis::health::Baseline;
-use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings, SpeedMode};
+use crate::analysis::monitor::{
+    ChannelMonitor, MonitorEvent, MonitorSettings, SpeedMode, TrendSettings,
+};
 use crate::analysis::speed::SpeedSearch;
 use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
@@ -31,7 +33,8 @@ use crate::config::{Config, SensorConfig, Speed};
 use crate::messages::{
     ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage, HealthStage,
     IndicatorsMessage, IngestMessage, IsoZone, PipelineMessage, RawBlock, SpectrumMessage,
-    SpeedMessage, SpeedSource, VelocityFlagMessage, VelocityMessage, VELOCITY_FLAG_NAME,
+    SpeedMessage, SpeedSource, TrendMessage, VelocityFlagMessage, VelocityMessage,
+    VELOCITY_FLAG_NAME,
 };
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -185,6 +188,11 @@ pub fn monitor_settings(
         },
         baseline_windows: t.baseline_windows as u64,
         sigma: t.sigma,
+        trend: TrendSettings {
+            point_s: t.trend_point_s,
+            points: t.trend_points,
+            ..TrendSettings::default()
+        },
         clip_count: i32::from(i16::MAX),
         flat_line_samples: samples(1.0),
         speed: match sensor.speed {
@@ -595,6 +603,20 @@ fn handle_event(
                 alarm_mm_s: limits.cd_mm_s,
             })
         }
+        MonitorEvent::Trend { point, stage } => PipelineMessage::Trend(TrendMessage {
+            channel: channel.clone(),
+            end_sample: point.end_sample,
+            stage,
+            rms: point.rms,
+            points: point.points,
+            threshold: point.fit.map(|f| f.threshold),
+            rate_per_s: point.fit.map(|f| f.rate_per_s),
+            doubling_s: point.fit.and_then(|f| f.doubling_s),
+            time_to_threshold_s: point.fit.and_then(|f| f.time_to_threshold_s()),
+            earliest_s: point.fit.and_then(|f| f.earliest_s.map(|t| t - f.now_s)),
+            latest_s: point.fit.and_then(|f| f.latest_s.map(|t| t - f.now_s)),
+            confidence: point.confidence,
+        }),
         MonitorEvent::Stage(change) => PipelineMessage::Health(HealthMessage {
             channel: channel.clone(),
             end_sample: change.at_sample,

@@ -6,7 +6,8 @@ strict reader (summary, chunk indexes, CRCs):
 
 JSON on stdout: {"messages": [{"topic", "log_time", "publish_time", "json"}...]}, where
 "json" is the decoded message for the low-rate JSON topics (/log, /state, /twin, /flags,
-/health) and null for the others (raw, spectra, indicators: too many to print).
+/health, /velocity_flags, /trend) and null for the others (raw, spectra, indicators: too
+many to print).
 Exit status 1 when the file does not read strictly.
 """
 
@@ -15,7 +16,7 @@ import sys
 
 from mcap.reader import make_reader
 
-DECODED = ("/log", "/state", "/twin/", "/flags/", "/health/", "/velocity_flags/")
+DECODED = ("/log", "/state", "/twin/", "/flags/", "/health/", "/velocity_flags/", "/trend/")
 
 
 def main():

@@ -15,6 +15,47 @@ fn bearingd(args: &[&str]) -> Output {
         .expect("run bearingd")
 }
 
+/// What `tests/python/<script> FILE` prints (JSON), asserting that it succeeded.
+fn python_json(py: &Path, script: &str, file: &Path) -> serde_json::Value {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/python")
+        .join(script);
+    let out = Command::new(py).arg(path).arg(file).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{script} {}: {}{}",
+        file.display(),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// The committed config with `replacements` made (each must apply), an iceoryx2 root of the
+/// test's own, written to `dir/<name>.toml`.
+fn config_with(dir: &Path, name: &str, replacements: &[(&str, &str)]) -> PathBuf {
+    let committed =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("config/bearingd.toml"))
+            .unwrap();
+    let mut text = committed.replace(
+        "\"/run/bearingd/iceoryx2\"",
+        &format!("\"/dev/shm/bearingd-{name}-{}\"", std::process::id()),
+    );
+    for (from, to) in replacements {
+        assert!(text.contains(from), "{from} is not in config/bearingd.toml");
+        text = text.replace(from, to);
+    }
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// `bearingd run --fast` of `config` for `seconds`, logging under `data`; its log files.
+fn fast_run_logs(config: &Path, data: &Path, seconds: &str) -> Vec<PathBuf> {
+    crate::replay::fast_run(config, data, seconds);
+    mcap_files(&data.join("mcap"))
+}
+
 /// (channel, fault, from, to, sample) of every flag change in the logs.
 fn logged_flags(files: &[PathBuf]) -> Vec<(String, String, String, String, u64)> {
     read_messages(files)
@@ -437,4 +478,138 @@ fn imported_cwru_records_replayed_raise_the_right_flags() {
         }
     }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// The Hammerstein–Wiener model online (issue 13 item 3): `bearingd run` re-identifies it with
+/// each twin fit and logs it to `/hw/<sensor>/<axis>`; Python's strict reader reads it back and
+/// recomputes each model's free-run accuracy from its logged time residual and the log's own
+/// raw samples; the replay (which serves every re-fit request) learns the baseline and then
+/// reports the drift on every fit.
+#[test]
+fn the_hw_model_is_logged_with_its_time_residuals_and_python_recomputes_its_accuracy() {
+    let dir = scratch_dir("daemon-hw");
+    let config = config_with(
+        &dir,
+        "hw",
+        &[
+            ("refit_period_s = 10.0", "refit_period_s = 2.0"),
+            ("hw_baseline_fits = 10", "hw_baseline_fits = 4"),
+        ],
+    );
+    let live = fast_run_logs(&config, &dir.join("data"), "40");
+    let replay_dir = dir.join("replay");
+    let out = bearingd(&[
+        "replay",
+        live[0].to_str().unwrap(),
+        "--out",
+        replay_dir.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let replayed = mcap_files(&replay_dir);
+
+    let Some(py) = python_mcap() else {
+        return;
+    };
+    let read = |file: &Path| python_json(&py, "hw_log.py", file);
+    for file in [&live[0], &replayed[0]] {
+        let log = read(file);
+        assert_eq!(log["schema"]["name"], "bearingd.Hw", "{log}");
+        let models = log["hw"].as_array().unwrap();
+        assert!(!models.is_empty(), "no /hw message in {}", file.display());
+        for m in models {
+            assert!(m["problem"].is_null(), "{m}");
+            // 2,560 samples less the three differences of the inputs a⁽¹⁾…a⁽³⁾.
+            assert_eq!(m["residual_len"], 2557, "{m}");
+            assert_eq!(m["one_step_len"], 2557, "{m}");
+            assert!(m["recomputed_accuracy"].is_f64(), "{m}");
+        }
+    }
+    // The replay serves every request (the fast live run drops the ones that arrive while the
+    // re-fit thread is busy): one model per 2 s from the first fit, the baseline after four.
+    let log = read(&replayed[0]);
+    let models = log["hw"].as_array().unwrap();
+    assert!(models.len() >= 12, "{} models", models.len());
+    for (k, m) in models.iter().enumerate() {
+        assert_eq!(m["warm_start"], k > 0, "{m}");
+        let learned = k >= 4;
+        assert_eq!(m["baseline_fits"], (k + 1).min(4), "{m}");
+        assert_eq!(m["residual_drift_sigma"].is_f64(), learned, "{m}");
+        assert_eq!(m["parameter_drift"].is_f64(), learned, "{m}");
+    }
+}
+
+/// The RMS trend with the health stage (issue 13 item 5), read back by Python: the embedded
+/// default's fault ramps in from 30 s, so the stage goes healthy → degrading; a point every
+/// `trend_point_s`; the trend and its time to the failure limit only once the limit is learned
+/// in the degrading stage.
+#[test]
+fn the_rms_trend_is_published_with_the_stage_and_predicts_only_once_the_limit_is_known() {
+    let dir = scratch_dir("daemon-trend");
+    let config = config_with(
+        &dir,
+        "trend",
+        &[("trend_point_s = 60.0", "trend_point_s = 5.0")],
+    );
+    let live = fast_run_logs(&config, &dir.join("data"), "120");
+    let Some(py) = python_mcap() else {
+        return;
+    };
+    let log = python_json(&py, "log_topics.py", &live[0]);
+    let trend: Vec<&serde_json::Value> = log["messages"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|m| m["topic"] == "/trend/motor-de/radial")
+        .map(|m| &m["json"])
+        .collect();
+    // 120 s at a point per 5 s (the first span starts at the first window's end).
+    assert!((22..=24).contains(&trend.len()), "{} points", trend.len());
+    let stage_rank = |m: &serde_json::Value| {
+        ["learning", "healthy", "degrading", "failing"]
+            .iter()
+            .position(|s| m["stage"] == *s)
+            .unwrap()
+    };
+    assert!(trend
+        .windows(2)
+        .all(|w| stage_rank(w[0]) <= stage_rank(w[1])));
+    let rms = |m: &serde_json::Value| m["rms"].as_f64().unwrap();
+    let healthy: Vec<f64> = trend
+        .iter()
+        .filter(|m| stage_rank(m) <= 1)
+        .map(|m| rms(m))
+        .collect();
+    let degrading: Vec<&&serde_json::Value> =
+        trend.iter().filter(|m| m["stage"] == "degrading").collect();
+    assert!(!healthy.is_empty() && degrading.len() >= 10, "{trend:?}");
+    // Before the fault the points sit at the machine's level; the fault triples it.
+    assert!(
+        healthy.iter().all(|&r| (0.05..0.08).contains(&r)),
+        "{healthy:?}"
+    );
+    assert!(
+        rms(degrading.last().unwrap()) > 2.5 * healthy[0],
+        "{trend:?}"
+    );
+    // No prediction before the failure limit is learned, one after.
+    for m in trend.iter().filter(|m| stage_rank(m) <= 1) {
+        assert!(
+            m["threshold"].is_null() && m["time_to_threshold_s"].is_null(),
+            "{m}"
+        );
+    }
+    let predicted: Vec<&&&serde_json::Value> = degrading
+        .iter()
+        .filter(|m| m["threshold"].is_f64())
+        .collect();
+    assert!(!predicted.is_empty(), "{trend:?}");
+    let first = predicted[0];
+    assert!(first["threshold"].as_f64().unwrap() > rms(first), "{first}");
+    assert!(first["rate_per_s"].as_f64().unwrap() > 0.0, "{first}");
+    assert!(first["time_to_threshold_s"].is_f64(), "{first}");
 }

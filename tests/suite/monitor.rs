@@ -32,6 +32,7 @@ fn settings(fs: f64) -> MonitorSettings {
         speed: SpeedMode::Fixed,
         // The velocity severity runs too: its readings must not depend on block sizes either.
         severity: Some(bearingd::analysis::iso::SeveritySettings::default()),
+        trend: bearingd::analysis::monitor::TrendSettings::default(),
     }
 }
 
@@ -101,6 +102,10 @@ fn describe(event: MonitorEvent, events: &mut Vec<String>) {
         MonitorEvent::Stage(change) => {
             events.push(format!("stage {:?} at {}", change.to, change.at_sample))
         }
+        MonitorEvent::Trend { point, stage } => events.push(format!(
+            "trend {:.6} g {stage:?} at {}",
+            point.rms, point.end_sample
+        )),
         MonitorEvent::Bands {
             at_sample, bands, ..
         } => events.push(format!("bands at {at_sample}: {bands:?}")),

@@ -48,7 +48,7 @@ fn config_at(dir: &Path, name: &str, rate_hz: u32, file_s: u32) -> PathBuf {
 }
 
 /// `bearingd run --fast` of `config` on `data` for `seconds` of signal.
-fn fast_run(config: &Path, data: &Path, seconds: &str) {
+pub(crate) fn fast_run(config: &Path, data: &Path, seconds: &str) {
     let out = bearingd(&[
         "run",
         "--config",

@@ -77,6 +77,23 @@ impl Checker {
             "give how many standard deviations above the baseline mark a new health stage, \
              e.g. sigma = 3.0",
         );
+        let trend_point_s = self.number(
+            "thresholds.trend_point_s",
+            &raw.trend_point_s,
+            d.trend_point_s,
+            Limits::above_to(0.0, DAY_S),
+            "give the sample time per point of the RMS trend in seconds, e.g. trend_point_s = 60.0",
+        );
+        let trend_points = self
+            .integer(
+                "thresholds.trend_points",
+                &raw.trend_points,
+                i64::try_from(d.trend_points).unwrap_or(30),
+                4,
+                10_000,
+                "give how many trend points are fitted, at least 4, e.g. trend_points = 30",
+            )
+            .and_then(|n| usize::try_from(n).ok());
         Some(ThresholdConfig {
             watch_score: watch_score?,
             alarm_score: alarm_score?,
@@ -85,6 +102,8 @@ impl Checker {
             off_delay_s: off_delay_s?,
             baseline_windows: baseline_windows?,
             sigma: sigma?,
+            trend_point_s: trend_point_s?,
+            trend_points: trend_points?,
         })
     }
 

@@ -19,9 +19,43 @@ impl Checker {
             Limits::above_to(0.05, 10.0),
             "give the length of signal each twin fit uses in seconds, e.g. window_s = 1.0",
         );
+        let hw_enabled = self.or_default(
+            "twin.hw_enabled",
+            &raw.hw_enabled,
+            d.hw_enabled,
+            "use true to re-identify the Hammerstein–Wiener model with each fit, or false",
+        );
+        let hw_order = self.integer(
+            "twin.hw_order",
+            &raw.hw_order,
+            0,
+            0,
+            9,
+            "give the HW model's output state order, e.g. hw_order = 0 (the acceleration)",
+        );
+        let hw_samples = self.integer(
+            "twin.hw_samples",
+            &raw.hw_samples,
+            i64::try_from(d.hw_samples).unwrap_or(2560),
+            256,
+            65_536,
+            "give how many of the newest samples the HW model is identified on, e.g. hw_samples = 2560",
+        );
+        let hw_baseline_fits = self.integer(
+            "twin.hw_baseline_fits",
+            &raw.hw_baseline_fits,
+            i64::try_from(d.hw_baseline_fits).unwrap_or(10),
+            2,
+            10_000,
+            "give how many HW fits form the healthy baseline, e.g. hw_baseline_fits = 10",
+        );
         Some(TwinConfig {
             refit_period_s: refit_period_s?,
             window_s: window_s?,
+            hw_enabled: hw_enabled?,
+            hw_order: usize::try_from(hw_order?).ok()?,
+            hw_samples: usize::try_from(hw_samples?).ok()?,
+            hw_baseline_fits: u64::try_from(hw_baseline_fits?).ok()?,
         })
     }
 }

@@ -144,6 +144,23 @@ impl FleetSink {
                     },
                 )
             }
+            PipelineMessage::Hw(m) => (
+                &m.channel,
+                m.end_sample,
+                Observed::Hw {
+                    accuracy: m.accuracy_simulation,
+                    residual_drift_sigma: m.residual_drift_sigma,
+                    parameter_drift: m.parameter_drift,
+                },
+            ),
+            PipelineMessage::Trend(m) => (
+                &m.channel,
+                m.end_sample,
+                Observed::Trend {
+                    time_to_limit_s: m.time_to_threshold_s,
+                    earliest_s: m.earliest_s,
+                },
+            ),
             PipelineMessage::Speed(m) => (&m.channel, m.end_sample, Observed::Speed(m.rpm)),
             // Every reading: the metrics go at the publish period, a new zone at once.
             PipelineMessage::Velocity(m) => (

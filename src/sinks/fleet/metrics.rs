@@ -60,6 +60,19 @@ pub enum Observed {
         residual_energy_ratio: f64,
         residual_peak_hz: f64,
     },
+    /// A re-identification of the HW model (seed 003): its free-run accuracy (%) and its
+    /// drift against the channel's baseline (`None` while the baseline is learned).
+    Hw {
+        accuracy: f64,
+        residual_drift_sigma: Option<f64>,
+        parameter_drift: Option<f64>,
+    },
+    /// A point of the RMS trend: the predicted time to the failure limit and the band's
+    /// earliest (`None`: no prediction).
+    Trend {
+        time_to_limit_s: Option<f64>,
+        earliest_s: Option<f64>,
+    },
     /// The speed the channel scores with (`None`: none usable).
     Speed(Option<f64>),
     /// The sensor went silent (`true`) or came back.
@@ -90,7 +103,12 @@ const TWIN_MARGIN: usize = 11;
 const TWIN_RESIDUAL_ENERGY: usize = 12;
 const TWIN_RESIDUAL_PEAK: usize = 13;
 const TWIN_ERRORS: usize = 14; // three: outer race, inner race, ball
-const FAULTS: usize = 17; // per fault kind: flag, confidence, score
+const HW_ACCURACY: usize = 17;
+const HW_RESIDUAL_DRIFT: usize = 18;
+const HW_PARAMETER_DRIFT: usize = 19;
+const TIME_TO_LIMIT: usize = 20;
+const TIME_TO_LIMIT_EARLIEST: usize = 21;
+const FAULTS: usize = 22; // per fault kind: flag, confidence, score
 const PER_FAULT: usize = 3;
 
 impl Catalog {
@@ -114,6 +132,11 @@ impl Catalog {
             ("Twin/Error/outer_race", Double),
             ("Twin/Error/inner_race", Double),
             ("Twin/Error/ball", Double),
+            ("HW/Accuracy", Double),
+            ("HW/ResidualDrift_sigma", Double),
+            ("HW/ParameterDrift", Double),
+            ("Health/TimeToLimit_s", Double),
+            ("Health/TimeToLimitEarliest_s", Double),
         ]
         .into_iter()
         .map(|(n, t)| (n.to_string(), t))
@@ -314,6 +337,22 @@ impl MetricBook {
                 for (k, e) in errors.into_iter().enumerate() {
                     set(TWIN_ERRORS + k, double(e));
                 }
+            }
+            Observed::Hw {
+                accuracy,
+                residual_drift_sigma,
+                parameter_drift,
+            } => {
+                set(HW_ACCURACY, double(accuracy));
+                set(HW_RESIDUAL_DRIFT, residual_drift_sigma.and_then(double));
+                set(HW_PARAMETER_DRIFT, parameter_drift.and_then(double));
+            }
+            Observed::Trend {
+                time_to_limit_s,
+                earliest_s,
+            } => {
+                set(TIME_TO_LIMIT, time_to_limit_s.and_then(double));
+                set(TIME_TO_LIMIT_EARLIEST, earliest_s.and_then(double));
             }
             Observed::Speed(rpm) => set(RPM, rpm.and_then(double)),
             Observed::SensorLost(lost) => {

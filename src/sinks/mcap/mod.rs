@@ -231,6 +231,8 @@ impl McapSink {
             PipelineMessage::Spectrum(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Indicators(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Twin(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Hw(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Trend(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Flag(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Health(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Speed(m) => at(&m.channel.sensor, m.end_sample),

@@ -22,7 +22,9 @@
 //! - [`model`]: the identified model, its free-run simulation and one-step prediction, the
 //!   accuracy `100·(1 − NRMSE)` of each;
 //! - [`identify`]: ARX start, polynomial by least squares, Levenberg–Marquardt on the
-//!   output error; a previous model as a warm start (the daemon's periodic re-fit).
+//!   output error; a previous model as a warm start (the daemon's periodic re-fit);
+//! - [`online`]: one channel's model over time, warm-started, and its drift against the
+//!   channel's healthy baseline (the daemon's `/hw` topic).
 //!
 //! No clock, no file, no panic on any input: NaN samples, a constant record, a record too short
 //! for the model are [`HwError`]s naming what is wrong.
@@ -30,11 +32,13 @@
 pub mod identify;
 pub mod linear;
 pub mod model;
+pub mod online;
 pub mod output;
 pub mod states;
 
 pub use identify::{identify, HwFit};
 pub use model::{Accuracy, HwModel, Responses};
+pub use online::{HwTracker, HwUpdate};
 pub use states::{StateFilter, VirtualStates};
 
 use serde::{Deserialize, Serialize};
