@@ -347,7 +347,7 @@ impl AlertSink {
     ) {
         match *self {}
     }
-    fn note_twin(&mut self, _: &TwinMessage) {
+    fn note_twin(&mut self, _: &crate::messages::TwinMessage) {
         match *self {}
     }
     fn finish(self) -> PublisherSummary {
