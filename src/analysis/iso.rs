@@ -188,9 +188,13 @@ pub struct VelocityIntegrator {
     input: Vec<f32>,
     spectrum: Vec<Complex32>,
     scratch: Vec<Complex32>,
-    /// Per bin: `2 / (N Σw²) · (g / 2πf)²` inside the band, 0 outside; bin power × weight is
-    /// that bin's share of the velocity mean square in (m/s)².
-    weights: Vec<f64>,
+    /// `1 / (N Σw²) · (g / 2π)²`: bin `k` at `f` in the band weighs `sides · scale / f²` (sides
+    /// 2, or 1 for DC and Nyquist), and bin power × weight is that bin's share of the velocity
+    /// mean square in (m/s)². Computed per window, not stored per bin: a table would be 128 KiB
+    /// per channel for a few thousand divisions every half second.
+    scale: f64,
+    /// The bins inside the band.
+    bins: std::ops::RangeInclusive<usize>,
     fs_hz: f64,
     band: (f64, f64),
 }
@@ -202,25 +206,19 @@ impl VelocityIntegrator {
         let hann = plans.hann_window(window);
         let sum_w2: f64 = hann.iter().map(|&w| f64::from(w) * f64::from(w)).sum();
         let bin_hz = fs_hz / window as f64;
-        let weights = (0..=window / 2)
-            .map(|k| {
-                let f = k as f64 * bin_hz;
-                // The Nyquist bin (and DC) have no mirror image: counted once, not twice.
-                let sides = if k == 0 || k == window / 2 { 1.0 } else { 2.0 };
-                if f >= band.0 && f <= band.1 && f > 0.0 {
-                    sides / (window as f64 * sum_w2) * (G / (std::f64::consts::TAU * f)).powi(2)
-                } else {
-                    0.0
-                }
-            })
-            .collect();
+        let scale = (G / std::f64::consts::TAU).powi(2) / (window as f64 * sum_w2);
+        // Bins strictly above 0 Hz whose frequency lies in the band.
+        let first = ((band.0 / bin_hz).ceil() as usize).max(1);
+        let last = ((band.1 / bin_hz).floor() as usize).min(window / 2);
+        let bins = first..=last;
         VelocityIntegrator {
             input: fft.make_input_vec(),
             spectrum: fft.make_output_vec(),
             scratch: fft.make_scratch_vec(),
             fft,
             hann,
-            weights,
+            scale,
+            bins,
             fs_hz,
             band,
         }
@@ -270,19 +268,17 @@ impl VelocityIntegrator {
             self.fft
                 .process_with_scratch(&mut self.input, &mut self.spectrum, &mut self.scratch);
         let mut total = 0.0;
-        match per_bin {
-            Some(out) => {
-                for ((c, &w), o) in self.spectrum.iter().zip(&self.weights).zip(out.iter_mut()) {
-                    let share = f64::from(c.norm_sqr()) * w;
-                    *o += share;
-                    total += share;
-                }
+        let mut per_bin = per_bin;
+        let half = n / 2;
+        for k in self.bins.clone() {
+            let f = k as f64 * self.bin_hz();
+            // The Nyquist bin has no mirror image: counted once, not twice.
+            let sides = if k == half { 1.0 } else { 2.0 };
+            let share = f64::from(self.spectrum[k].norm_sqr()) * sides * self.scale / (f * f);
+            if let Some(out) = per_bin.as_deref_mut().and_then(|o| o.get_mut(k)) {
+                *out += share;
             }
-            None => {
-                for (c, &w) in self.spectrum.iter().zip(&self.weights) {
-                    total += f64::from(c.norm_sqr()) * w;
-                }
-            }
+            total += share;
         }
         total
     }

@@ -314,7 +314,8 @@ impl ChannelMonitor {
                 freqs.shaft * 60.0,
                 severity,
                 settings.analysis.averages,
-                &mut crate::analysis::envelope::FftPlans::default(),
+                // The process's cache: plans and Hann windows once per size, not per channel.
+                &mut crate::analysis::envelope::FftPlans::shared(),
             );
             let phase = share_of(tracker.hop(), settings.window_stagger);
             let tracker = tracker.with_phase(phase);
