@@ -15,6 +15,25 @@ fn bearingd(args: &[&str]) -> Output {
         .expect("run bearingd")
 }
 
+/// `bearingd replay LOG --out DIR --quiet` and `extra`; asserts that it succeeded.
+fn replay_log(log: &Path, out_dir: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "replay",
+        log.to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+        "--quiet",
+    ];
+    args.extend_from_slice(extra);
+    let out = bearingd(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// What `tests/python/<script> FILE` prints (JSON), asserting that it succeeded.
 fn python_json(py: &Path, script: &str, file: &Path) -> serde_json::Value {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -124,19 +143,7 @@ fn run_logs_to_mcap_and_a_replay_raises_the_same_flags_at_the_same_samples() {
     }
 
     let replay_dir = dir.join("replay");
-    let out = bearingd(&[
-        "replay",
-        live[0].to_str().unwrap(),
-        "--out",
-        replay_dir.to_str().unwrap(),
-        "--quiet",
-        "--json",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = replay_log(&live[0], &replay_dir, &["--json"]);
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(summary["samples"], 90 * 25_600);
     let replayed = logged_flags(&mcap_files(&replay_dir));
@@ -391,19 +398,10 @@ iceoryx2_root = "{iox}"
     }
 
     let replay_dir = dir.join("replay");
-    let out = bearingd(&[
-        "replay",
-        "--config",
-        config_path.to_str().unwrap(),
-        "--out",
-        replay_dir.to_str().unwrap(),
-        "--quiet",
-        live[0].to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    replay_log(
+        &live[0],
+        &replay_dir,
+        &["--config", config_path.to_str().unwrap()],
     );
     assert_eq!(logged_flags(&mcap_files(&replay_dir)), live_flags);
     let _ = std::fs::remove_dir_all(&iox_root);
@@ -498,18 +496,7 @@ fn the_hw_model_is_logged_with_its_time_residuals_and_python_recomputes_its_accu
     );
     let live = fast_run_logs(&config, &dir.join("data"), "40");
     let replay_dir = dir.join("replay");
-    let out = bearingd(&[
-        "replay",
-        live[0].to_str().unwrap(),
-        "--out",
-        replay_dir.to_str().unwrap(),
-        "--quiet",
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    replay_log(&live[0], &replay_dir, &[]);
     let replayed = mcap_files(&replay_dir);
 
     let Some(py) = python_mcap() else {
