@@ -716,25 +716,39 @@ fn start_simulated(
 /// Feeds the simulated sensors' blocks, paced at real time or as fast as the queue takes them,
 /// until `--duration` or until `stop` turns true (a signal): like the live sources, it must end
 /// for the shutdown to go on (without it SIGTERM never stopped a run with a simulated sensor).
+///
+/// In real time the sensors are out of phase, as independent sensor nodes are: of `n` sensors,
+/// the k-th delivers its block k/n of a block period after the first. In phase, every block of
+/// a period would reach the analysis thread at once, and the last sensor's window would wait
+/// behind all the others' (docs/PERFORMANCE.md, alert latency). The samples are the same
+/// either way: only when they are handed over changes.
 async fn feed_simulated(
     mut sims: Vec<SimSource>,
     tx: async_mpsc::Sender<Arrived>,
     options: RunOptions,
     mut stop: watch::Receiver<bool>,
 ) {
-    let mut ticker = tokio::time::interval(Duration::from_secs_f64(SIM_BLOCK_S));
+    let turns = sims.len().max(1);
+    let mut ticker = tokio::time::interval(Duration::from_secs_f64(SIM_BLOCK_S / turns as f64));
     ticker.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Delay);
+    let mut turn = 0;
     loop {
         if *stop.borrow() {
             return;
         }
-        if options.realtime {
+        // In real time one sensor per tick, in turn; as fast as possible, all at once.
+        let due = if options.realtime {
             tokio::select! {
                 _ = ticker.tick() => {},
                 _ = stop.changed() => return,
             }
-        }
-        for sim in sims.iter_mut() {
+            let due = turn..turn + 1;
+            turn = (turn + 1) % turns;
+            due
+        } else {
+            0..sims.len()
+        };
+        for sim in sims.get_mut(due).into_iter().flatten() {
             for input in sim.next_blocks() {
                 if tx.send(Arrived::now(input)).await.is_err() {
                     return;
