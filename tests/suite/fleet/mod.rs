@@ -367,7 +367,10 @@ fn a_full_queue_drops_the_oldest_counts_them_and_sends_the_rest_in_order() {
     broker.up();
     let host = Host::start(&broker, &setup.dir, 0);
     let started = Instant::now();
-    let second = NodeProcess::start(&setup, &config, &["--fast", "--duration", "5"]).wait(60);
+    // In real time, so that the bridge is connected for 10 s before the stop: a `--fast` run
+    // of a few seconds of sample time ended after about a second, and under load the stop's
+    // 3 s grace did not always deliver the whole backlog (the test failed with 42 of them).
+    let second = NodeProcess::start(&setup, &config, &["--duration", "10"]).wait(60);
     assert!(second.success, "{}", second.stderr);
     assert!(
         second
