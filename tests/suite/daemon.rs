@@ -2,6 +2,7 @@
 //! log is read by Python's strict reader, a replay raises the same flags at the same samples,
 //! a `kill -9` loses at most the open chunk, and a bad config refuses to start.
 
+use crate::replay::replay_json;
 use bearingd::mcap_log::read_messages;
 use bearingd::messages::PipelineMessage;
 use bearingd_testdata::{check_mcap_with_python, mcap_files, python_mcap, scratch_dir};
@@ -13,25 +14,6 @@ fn bearingd(args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("run bearingd")
-}
-
-/// `bearingd replay LOG --out DIR --quiet` and `extra`; asserts that it succeeded.
-fn replay_log(log: &Path, out_dir: &Path, extra: &[&str]) -> Output {
-    let mut args = vec![
-        "replay",
-        log.to_str().unwrap(),
-        "--out",
-        out_dir.to_str().unwrap(),
-        "--quiet",
-    ];
-    args.extend_from_slice(extra);
-    let out = bearingd(&args);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
 }
 
 /// What `tests/python/<script> FILE` prints (JSON), asserting that it succeeded.
@@ -143,8 +125,7 @@ fn run_logs_to_mcap_and_a_replay_raises_the_same_flags_at_the_same_samples() {
     }
 
     let replay_dir = dir.join("replay");
-    let out = replay_log(&live[0], &replay_dir, &["--json"]);
-    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (summary, _) = replay_json(&live[..1], &replay_dir, &[]);
     assert_eq!(summary["samples"], 90 * 25_600);
     let replayed = logged_flags(&mcap_files(&replay_dir));
     assert_eq!(
@@ -398,8 +379,8 @@ iceoryx2_root = "{iox}"
     }
 
     let replay_dir = dir.join("replay");
-    replay_log(
-        &live[0],
+    replay_json(
+        &live[..1],
         &replay_dir,
         &["--config", config_path.to_str().unwrap()],
     );
@@ -496,7 +477,7 @@ fn the_hw_model_is_logged_with_its_time_residuals_and_python_recomputes_its_accu
     );
     let live = fast_run_logs(&config, &dir.join("data"), "40");
     let replay_dir = dir.join("replay");
-    replay_log(&live[0], &replay_dir, &[]);
+    replay_json(&live[..1], &replay_dir, &[]);
     let replayed = mcap_files(&replay_dir);
 
     let Some(py) = python_mcap() else {
