@@ -243,7 +243,7 @@ impl VelocityIntegrator {
         &mut self,
         older: &[f32],
         newer: &[f32],
-        per_bin: Option<&mut [f64]>,
+        mut per_bin: Option<&mut [f64]>,
     ) -> f64 {
         let n = self.input.len();
         if older.len() + newer.len() != n {
@@ -268,7 +268,6 @@ impl VelocityIntegrator {
             self.fft
                 .process_with_scratch(&mut self.input, &mut self.spectrum, &mut self.scratch);
         let mut total = 0.0;
-        let mut per_bin = per_bin;
         let half = n / 2;
         for k in self.bins.clone() {
             let f = k as f64 * self.bin_hz();

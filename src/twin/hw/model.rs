@@ -252,20 +252,19 @@ impl HwModel {
     /// Never worse than from rest: where no `α` does better than none, that is `h(w)`.
     fn simulate_from_estimated_state(&self, w: &[f64], y: &[f64]) -> Vec<f64> {
         let n = w.len().min(y.len());
-        let columns: Vec<Vec<f64>> = self
-            .linear
-            .iter()
-            .flat_map(|tf| {
-                (0..tf.f.len()).map(move |j| {
-                    let mut z = vec![0.0; n];
-                    if j < n {
-                        z[j] = 1.0;
-                    }
-                    super::linear::filter_denominator(&tf.f, &mut z);
-                    z
-                })
-            })
-            .collect();
+        // One column per pole of every block: an impulse at sample j filtered by 1/Fᵢ.
+        let poles: usize = self.linear.iter().map(|tf| tf.f.len()).sum();
+        let mut basis = DMatrix::zeros(n, poles);
+        let mut column = 0;
+        for tf in &self.linear {
+            for j in 0..tf.f.len().min(n) {
+                let z = basis.column_mut(column + j);
+                let z = z.data.into_slice_mut();
+                z[j] = 1.0;
+                super::linear::filter_denominator(&tf.f, z);
+            }
+            column += tf.f.len();
+        }
         let simulate = |free: &DVector<f64>| -> Vec<f64> {
             (0..n).map(|k| self.output.eval(w[k] + free[k])).collect()
         };
@@ -279,11 +278,10 @@ impl HwModel {
         };
         let mut free = DVector::zeros(n);
         let mut best = simulate(&free);
-        if columns.is_empty() || n <= columns.len() {
+        if basis.ncols() == 0 || n <= basis.ncols() {
             return best;
         }
         let mut best_error = error(&best);
-        let basis = DMatrix::from_fn(n, columns.len(), |k, c| columns[c][k]);
         let solve = |a: DMatrix<f64>, b: &DVector<f64>| a.svd(true, true).solve(b, 1e-9).ok();
         let inverted =
             DVector::from_iterator(n, (0..n).map(|k| self.output.invert(y[k], w[k]) - w[k]));
