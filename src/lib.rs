@@ -24,11 +24,15 @@
 //!   [`Sink`](pipeline::Sink) trait, the seam to the sinks.
 //! - [`config`]: the TOML configuration, parsed raw then validated into typed settings (one file
 //!   per section), with every problem reported at once.
+//! - [`learned`]: the learned diagnosis (seed 001): a denoising autoencoder + 1-D CNN trained
+//!   only on synthetic records (`bearingd train`), run with candle; an extra opinion that the
+//!   envelope evidence must back (`analyze --learned`, `twin.learned_model`).
 //! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the
 //!   `bearing-iox` crate, shared with the publishers).
 //! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits),
-//!   the 6-DOF physics model and its calibration (`twin::physics`), and the
-//!   Hammerstein–Wiener identification (`twin::hw`).
+//!   the 6-DOF physics model and its calibration (`twin::physics`), the
+//!   Hammerstein–Wiener identification (`twin::hw`) and labelled synthetic data sets made with
+//!   either model (`twin::dataset`, `bearingd dataset`).
 //! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
 //!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
 //!   cannot disagree.
@@ -54,6 +58,7 @@ pub mod config;
 pub mod daemon;
 pub mod evaluate;
 pub mod iox;
+pub mod learned;
 pub mod life;
 pub mod mcap_log;
 pub mod messages;

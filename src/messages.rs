@@ -267,6 +267,34 @@ pub struct TwinMessage {
     /// Residual envelope spectrum (measured − twin) of the best hypothesis, amplitude per bin.
     pub residual_bin_hz: f64,
     pub residual: Vec<f32>,
+    /// The learned model's opinion of the same signal (`twin.learned_model`); absent when off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learned: Option<LearnedOpinionMessage>,
+}
+
+/// A learned model's opinion of a twin re-fit's signal, and what it settles with the envelope
+/// evidence (docs/PHYSICS.md §6): it may confirm the fault the envelope ranks first (clearly and
+/// significantly) while no flag names one; the flags stay the envelope's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct LearnedOpinionMessage {
+    pub segments: usize,
+    /// Most probable first; `fault` null: healthy.
+    pub probabilities: Vec<ClassProbability>,
+    /// The fault the combination names where the envelope alone names none; null otherwise.
+    pub confirms: Option<FaultKind>,
+    /// Whether the network's most probable class is what the envelope (or the combination)
+    /// says.
+    pub agrees: bool,
+    /// Why the network gave no opinion (an error of its own); null when it gave one.
+    pub problem: Option<String>,
+}
+
+/// One class of a learned opinion.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ClassProbability {
+    /// null: healthy.
+    pub fault: Option<FaultKind>,
+    pub probability: f64,
 }
 
 /// The Hammerstein–Wiener model of seed 003 (docs/HW.md), re-identified with each twin fit on

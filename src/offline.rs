@@ -10,6 +10,7 @@ use crate::analysis::iso::{record_severity, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
 use crate::bearing::{BearingError, BearingGeometry};
+use crate::learned::{combine as combine_learned, EnvelopeView, LearnedModel, ModelError};
 use crate::messages::FaultKind;
 use crate::recording::{read_recording, ReadOptions, Recording, RecordingError, RecordingFormat};
 use crate::report::{AnalyzeReport, RecordContext, SpeedSource, TwinReport};
@@ -33,6 +34,9 @@ pub struct AnalyzeRequest {
     pub twin: bool,
     /// The machine group and foundation the ISO 10816-3 velocity zones are judged for.
     pub severity: SeveritySettings,
+    /// A learned model's second opinion, combined with the envelope diagnosis
+    /// (`analyze --learned`; see [`crate::learned::combine`]).
+    pub learned: Option<std::sync::Arc<LearnedModel>>,
 }
 
 /// Why a recording could not be analysed. Each message names the file and the fix.
@@ -44,6 +48,8 @@ pub enum OfflineError {
     Analysis { file: String, source: AnalysisError },
     #[error(transparent)]
     Bearing(#[from] BearingError),
+    #[error("{file}: the learned opinion failed: {source}")]
+    Learned { file: String, source: ModelError },
     #[error("{file}: the sample rate is unknown ({format} files do not state it); give it with --fs, e.g. --fs 12000")]
     UnknownSampleRate {
         file: String,
@@ -116,7 +122,8 @@ fn data_set_facts(recording: &Recording) -> DataSetFacts {
         },
         RecordingFormat::McapLog => DataSetFacts {
             rpm: None,
-            bearing: embedded_default_bearing(&recording.channel),
+            bearing: logged_bearing(&recording.path, &recording.channel)
+                .or_else(|| embedded_default_bearing(&recording.channel)),
         },
         RecordingFormat::Matlab | RecordingFormat::PlainCsv | RecordingFormat::Wav => {
             DataSetFacts::default()
@@ -124,8 +131,22 @@ fn data_set_facts(recording: &Recording) -> DataSetFacts {
     }
 }
 
-/// The bearing of sensor `sensor/axis` in the embedded default config, for logs of
-/// `bearingd run` without a config: the log does not record its bearing yet.
+/// The bearing of sensor `sensor/axis` in the config a log records (its `bearingd.config`
+/// record: logs of `bearingd run`, `import` and `dataset`).
+fn logged_bearing(path: &std::path::Path, channel: &str) -> Option<(BearingGeometry, String)> {
+    let sensor = channel.split('/').next()?;
+    let json = crate::mcap_log::read_header(path).ok()?.config_json?;
+    let config = crate::config::config_from_log(&json).ok()?;
+    let found = config.sensors.into_iter().find(|s| s.id == sensor)?;
+    let name = found.bearing.name.clone();
+    Some((
+        found.bearing,
+        format!("{name}, the bearing of sensor '{sensor}' in the config the log records"),
+    ))
+}
+
+/// The bearing of sensor `sensor/axis` in the embedded default config, for logs that record
+/// no config (written before logs carried it).
 fn embedded_default_bearing(channel: &str) -> Option<(BearingGeometry, String)> {
     let sensor = channel.split('/').next()?;
     let config = crate::config::Config::default_embedded().ok()?;
@@ -326,6 +347,21 @@ pub fn analyze(
         report.twin = Some(TwinReport::new(&twin, fit_ms, agrees, note));
         twin
     });
+    if let Some(model) = &request.learned {
+        let opinion = model
+            .opinion(&samples, fs_hz, rpm / 60.0, &report.bearing_geometry)
+            .map_err(|source| OfflineError::Learned {
+                file: report.file.clone(),
+                source,
+            })?;
+        let view = EnvelopeView::of(
+            &analysis.diagnosis,
+            analysis.hypotheses.iter().map(|h| &h.score),
+            &request.settings.decision_rule(),
+        );
+        let combined = combine_learned(&view, &opinion);
+        report.set_learned(opinion, combined);
+    }
     Ok(AnalyzeOutcome {
         analysis,
         report,

@@ -88,6 +88,7 @@ fn every_type() -> Vec<PipelineMessage> {
             residual_peak_hz: 214.7,
             residual_bin_hz: 0.5,
             residual: vec![-0.25, 0.5, 1e-3],
+            learned: None,
         }),
         PipelineMessage::Hw(HwMessage {
             channel: c.clone(),
@@ -740,6 +741,7 @@ fn bytes_per_day_of_one_25k6_channel() {
                 residual_peak_hz: 214.7,
                 residual_bin_hz: 0.78125,
                 residual: spectrum_src.iter().take(1024).map(|v| v * 0.1).collect(),
+                learned: None,
             };
             logger.log(&PipelineMessage::Twin(m), t, t).unwrap();
         }

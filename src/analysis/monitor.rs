@@ -460,6 +460,16 @@ impl ChannelMonitor {
         self.bands_known.then_some(&self.bands)
     }
 
+    /// The latest window's fault scores, in [`FaultKind::ALL`] order.
+    pub fn latest_scores(&self) -> &[FaultScore; 4] {
+        &self.scores
+    }
+
+    /// The verdict's rule the flags are fed by.
+    pub fn decision_rule(&self) -> super::diagnosis::DecisionRule {
+        self.settings.analysis.decision_rule()
+    }
+
     pub fn flag_levels(&self) -> [FlagLevel; 4] {
         self.flags.each_ref().map(|f| f.level())
     }

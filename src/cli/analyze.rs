@@ -64,6 +64,11 @@ pub struct AnalyzeArgs {
     /// twin's spectrum to the text and the plot).
     #[arg(long)]
     twin: bool,
+    /// Add a learned model's opinion (a .safetensors file of `bearingd train`; the shipped one
+    /// for the SKF 6205-2RS: models/skf-6205-2rs.safetensors). It may settle what the envelope
+    /// leaves open, never overrule it; the JSON gains `learned`.
+    #[arg(long, conflicts_with = "hw")]
+    learned: Option<PathBuf>,
     /// ISO 10816-3 machine group for the velocity zones: 1 (above 300 kW, or shaft height
     /// from 315 mm) or 2 (15 to 300 kW, shaft height 160 to 315 mm).
     #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=2))]
@@ -128,6 +133,12 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
     } else {
         args.files.iter().cloned().map(Some).collect()
     };
+    let learned = match &args.learned {
+        Some(path) => Some(std::sync::Arc::new(
+            crate::learned::LearnedModel::load(path).map_err(CliError::input)?,
+        )),
+        None => None,
+    };
     let mut analyzer = RecordAnalyzer::default();
     let mut reports = Vec::new();
     let mut failures = Vec::new();
@@ -144,6 +155,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
             settings: settings.clone(),
             twin: args.twin,
             severity: severity_from(args),
+            learned: learned.clone(),
         };
         let outcome = match analyze(&request, &mut analyzer) {
             Ok(outcome) => outcome,

@@ -1,5 +1,5 @@
 //! `bearingd dataset --spec FILE --out DIR`: a labelled synthetic data set for learned
-//! diagnosis (see [`crate::evaluate::dataset`]): `dataset.npz` (NumPy: `x` records × samples in
+//! diagnosis (see [`crate::twin::dataset`]): `dataset.npz` (NumPy: `x` records × samples in
 //! g, `y` labels, and the drawn conditions), `manifest.csv` (one row per record, with its class
 //! name), a copy of the spec, and with `--mcap` each record as a self-describing raw MCAP log
 //! that `bearingd replay` reads as the daemon's own. Records are made on all cores, with a
@@ -8,7 +8,7 @@
 use super::import::{write_raw_log, RawLog};
 use super::CliError;
 use crate::bearing::BearingGeometry;
-use crate::evaluate::dataset::{DatasetRecord, DatasetSpec};
+use crate::twin::dataset::{DatasetRecord, DatasetSpec};
 use clap::Args;
 use ndarray::{Array1, Array2};
 use rayon::prelude::*;
@@ -100,7 +100,7 @@ fn progress_bar(records: u64) -> Option<indicatif::ProgressBar> {
 }
 
 /// `x` (records × samples, float32 g), `y` (labels, int64), and per record `rpm`, `noise_g`,
-/// `severity`, `load_n` (float64); `fs_hz` as a 0-d array.
+/// `severity`, `load_n`, `resonance_hz` (float64); `fs_hz` as a 0-d array.
 fn write_npz(
     path: &Path,
     records: &[DatasetRecord],
@@ -130,6 +130,8 @@ fn write_npz(
         .map_err(|e| fail(&e))?;
     npz.add_array("load_n", &column(|r| r.load_n))
         .map_err(|e| fail(&e))?;
+    npz.add_array("resonance_hz", &column(|r| r.resonance_hz))
+        .map_err(|e| fail(&e))?;
     npz.add_array("fs_hz", &ndarray::arr0(spec.fs_hz))
         .map_err(|e| fail(&e))?;
     npz.finish().map_err(|e| fail(&e))?;
@@ -144,13 +146,13 @@ fn write_manifest(path: &Path, records: &[DatasetRecord], mcap: bool) -> Result<
     let mut out = std::io::BufWriter::new(file);
     writeln!(
         out,
-        "index,label,fault,model,rpm,noise_g,severity,load_n,seed,mcap"
+        "index,label,fault,model,rpm,noise_g,severity,load_n,resonance_hz,seed,mcap"
     )
     .map_err(fail)?;
     for r in records {
         writeln!(
             out,
-            "{},{},{},{},{:.3},{:.5},{:.5},{:.1},{},{}",
+            "{},{},{},{},{:.3},{:.5},{:.5},{:.1},{:.1},{},{}",
             r.index,
             r.label,
             r.fault.name(),
@@ -159,6 +161,7 @@ fn write_manifest(path: &Path, records: &[DatasetRecord], mcap: bool) -> Result<
             r.noise_g,
             r.severity,
             r.load_n,
+            r.resonance_hz,
             r.seed,
             if mcap {
                 log_dir(r).display().to_string()

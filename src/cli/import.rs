@@ -7,7 +7,7 @@
 use super::{CliError, RecordingArgs};
 use crate::bearing::BearingGeometry;
 use crate::mcap_log::header::IMPORT_RECORD;
-use crate::messages::{ChannelId, PipelineMessage, RawBlock};
+use crate::messages::{ChannelId, PipelineMessage, RawBlock, SpeedMessage, SpeedSource};
 use crate::offline::{resolve_conditions, AnalyzeRequest};
 use crate::recording::{read_recording, time_from_name, NamedTimeKind};
 use crate::sinks::mcap::metadata::{run_records, MetadataRecord};
@@ -110,10 +110,7 @@ pub(super) struct WrittenLog {
 /// plus the same settings as `replay.toml`.
 pub(super) fn write_raw_log(log: &RawLog) -> Result<WrittenLog, CliError> {
     let (fs, rpm, b) = (log.fs_hz, log.rpm, log.bearing);
-    let bearing_spec = format!(
-        "z={},d={}mm,D={}mm,alpha={}",
-        b.rolling_elements, b.element_diameter_mm, b.pitch_diameter_mm, b.contact_angle_deg
-    );
+    let bearing_spec = b.spec();
     let peak = log.samples.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let scale = if peak > 0.0 {
         peak / FULL_SCALE_COUNTS
@@ -146,6 +143,18 @@ pub(super) fn write_raw_log(log: &RawLog) -> Result<WrittenLog, CliError> {
         ..LoggerConfig::new(log.out)
     };
     let mut logger = McapLogger::create(logger_config, log.origin_ns).map_err(CliError::input)?;
+    // The speed the record was taken at, stated in the log itself, so that `analyze` reads it
+    // from there (a replay scores with the config's fixed speed and passes this one over).
+    let speed = PipelineMessage::Speed(SpeedMessage {
+        channel: channel.clone(),
+        end_sample: 0,
+        source: SpeedSource::Fixed,
+        given_rpm: Some(rpm),
+        rpm: Some(rpm),
+    });
+    logger
+        .log(&speed, log.origin_ns, log.origin_ns)
+        .map_err(CliError::failure)?;
     let block = ((fs * BLOCK_S).round() as usize).max(1);
     for (i, chunk) in log.samples.chunks(block).enumerate() {
         let first_sample = (i * block) as u64;

@@ -19,6 +19,7 @@ mod ingest;
 mod replay;
 mod run;
 mod simulate;
+mod train;
 mod trend;
 
 use clap::{Args, Parser, Subcommand};
@@ -112,6 +113,9 @@ enum Command {
     /// Generate a labelled synthetic data set (signal model or physics twin) for learned
     /// diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log.
     Dataset(dataset::DatasetArgs),
+    /// Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of
+    /// `bearingd dataset`; writes a model file for `analyze --learned`.
+    Train(train::TrainArgs),
     /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
     /// to a measured record; prints the parameters and the fit error, plots the spectra.
     Calibrate(calibrate::CalibrateArgs),
@@ -161,6 +165,7 @@ pub fn main() -> ExitCode {
         Command::Import(args) => import::run(&args),
         Command::Simulate(args) => simulate::run(&args),
         Command::Dataset(args) => dataset::run(&args),
+        Command::Train(args) => train::run(&args),
         Command::Trend(args) => trend::run(&args),
         Command::Evaluate(args) => evaluate::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),

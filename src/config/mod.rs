@@ -48,6 +48,7 @@
 
 mod document;
 mod error;
+mod logged;
 mod raw;
 mod types;
 mod validate;
@@ -55,6 +56,7 @@ mod validate;
 use std::path::Path;
 
 pub use error::{ConfigError, ConfigProblem};
+pub use logged::config_from_log;
 pub use types::{
     Broker, CanConfig, Config, FleetConfig, OutputConfig, SensorConfig, ShmConfig, SimConfig,
     SimFault, Speed, ThresholdConfig, Transport, TwinConfig,

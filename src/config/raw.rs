@@ -146,6 +146,7 @@ pub(crate) struct RawTwin {
     pub hw_order: Field<i64>,
     pub hw_samples: Field<i64>,
     pub hw_baseline_fits: Field<i64>,
+    pub learned_model: Field<String>,
 }
 
 #[derive(Debug, Default, Deserialize)]

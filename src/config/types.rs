@@ -232,6 +232,10 @@ pub struct TwinConfig {
     /// HW fits that form a channel's healthy baseline.
     #[serde(default = "default_hw_baseline_fits")]
     pub hw_baseline_fits: u64,
+    /// A learned model (`bearingd train`) whose opinion of each re-fit's signal is logged with
+    /// the twin's fit, combined with the envelope evidence (docs/PHYSICS.md §6); none: off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learned_model: Option<std::path::PathBuf>,
 }
 
 // Logs written before the HW keys existed read as the defaults.
@@ -254,6 +258,7 @@ impl Default for TwinConfig {
             hw_order: 0,
             hw_samples: default_hw_samples(),
             hw_baseline_fits: default_hw_baseline_fits(),
+            learned_model: None,
         }
     }
 }

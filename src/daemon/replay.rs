@@ -125,6 +125,8 @@ pub struct ReplaySummary {
 pub enum ReplayError {
     #[error(transparent)]
     Sink(#[from] SinkError),
+    #[error("twin.learned_model of the replay's config: {0}; give --config with the model's path on this machine, or without the key")]
+    Learned(#[from] crate::learned::ModelError),
 }
 
 /// Replays the runs of `plan` with `config`'s sensors; `open_sinks` gives the sinks of each
@@ -159,7 +161,7 @@ pub fn replay(
     let mut reached: Option<BTreeMap<ChannelId, Baseline>> = None;
     for run in &plan.runs {
         let start = BaselinesFrom::choose(run, reached.as_ref());
-        let mut replayed = RunReplay::new(run, plan, config, start, options);
+        let mut replayed = RunReplay::new(run, plan, config, start, options)?;
         let result = replayed.go(open_sinks, &mut summary, &mut progress, events);
         reached = Some(replayed.pipeline.baselines());
         let counters = replayed.source.counters().clone();
@@ -212,7 +214,8 @@ impl<'a> RunReplay<'a> {
         config: &Config,
         (baselines_from, start_baselines): (BaselinesFrom, BTreeMap<ChannelId, Baseline>),
         options: &ReplayOptions,
-    ) -> Self {
+    ) -> Result<Self, ReplayError> {
+        let worker = TwinWorker::new(&config.twin)?;
         let pipeline = Pipeline::new(config, &start_baselines);
         let paths = plan.paths(run);
         let source = ReplaySource::open(
@@ -221,18 +224,18 @@ impl<'a> RunReplay<'a> {
             config.sample_rates(),
             options.speed,
         );
-        RunReplay {
+        Ok(RunReplay {
             run,
             source,
             pipeline,
             sinks: None,
-            worker: TwinWorker::new(&config.twin),
+            worker,
             next_sample: HashMap::new(),
             rates: config.sample_rates(),
             first_file: paths.first().cloned().unwrap_or_default(),
             baselines_from,
             start_baselines,
-        }
+        })
     }
 
     fn go(

@@ -101,6 +101,8 @@ pub enum RunError {
     ThreadPanicked { what: &'static str },
     #[error("sink thread failed: {0}")]
     Sink(#[from] SinkError),
+    #[error("twin.learned_model: {0}")]
+    Learned(#[from] crate::learned::ModelError),
 }
 
 /// What a run did, for the summary on exit.
@@ -162,7 +164,7 @@ pub async fn run(
     let (status_tx, status_rx) = watch::channel(pipeline.status());
 
     let sink = spawn("sink", move || sink_thread(sinks, &sink_rx))?;
-    let worker = TwinWorker::new(&config.twin);
+    let worker = TwinWorker::new(&config.twin)?;
     let refit = spawn("twin", move || refit_thread(worker, &request_rx, &fit_tx))?;
     let analysis = AnalysisThread {
         pipeline,

@@ -18,7 +18,6 @@
 //! Deterministic: a case's result depends only on the sweep seed and the case, never on the
 //! thread that ran it or the order; results are kept in case order.
 
-pub mod dataset;
 pub mod figure;
 pub mod run;
 pub mod summary;

@@ -449,6 +449,22 @@ mod tests {
                 residual_peak_hz: 50.0,
                 residual_bin_hz: 0.5,
                 residual: vec![0.0],
+                learned: Some(crate::messages::LearnedOpinionMessage {
+                    segments: 2,
+                    probabilities: vec![
+                        crate::messages::ClassProbability {
+                            fault: Some(FaultKind::OuterRace),
+                            probability: 0.9,
+                        },
+                        crate::messages::ClassProbability {
+                            fault: None,
+                            probability: 0.1,
+                        },
+                    ],
+                    confirms: None,
+                    agrees: true,
+                    problem: None,
+                }),
             }),
             PipelineMessage::Hw(HwMessage {
                 channel: channel(),

@@ -21,6 +21,7 @@ pub mod twin_queue;
 pub use refit::TwinWorker;
 pub use sink::{Sink, SinkError};
 
+use crate::analysis::diagnosis::Verdict;
 use crate::analysis::flags::FlagSettings;
 use crate::analysis::health::Baseline;
 use crate::analysis::monitor::{
@@ -30,6 +31,7 @@ use crate::analysis::speed::SpeedSearch;
 use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
 use crate::config::{Config, SensorConfig, Speed};
+use crate::learned::{clear_leader, EnvelopeView};
 use crate::messages::{
     ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage, HealthStage,
     IndicatorsMessage, IngestMessage, IsoZone, PipelineMessage, RawBlock, SpectrumMessage,
@@ -84,6 +86,23 @@ pub struct TwinRequest {
     /// Bands of the outer-race, inner-race and ball hypotheses.
     pub bands: [Band; 3],
     pub samples: Vec<f32>,
+    /// What the envelope evidence says at the request (for the learned opinion's combination).
+    pub envelope: EnvelopeView,
+}
+
+/// The envelope evidence of a channel as the learned opinion's combination reads it: the fault
+/// of the highest raised flag (none when every flag is ok) and the latest window's clear leader.
+fn envelope_view(monitor: &ChannelMonitor) -> EnvelopeView {
+    let levels = monitor.flag_levels();
+    let flagged = (0..4)
+        .filter(|&i| levels[i] != FlagLevel::Ok)
+        .max_by_key(|&i| levels[i])
+        .map(|i| FaultKind::ALL[i]);
+    EnvelopeView {
+        verdict: flagged.map_or(Verdict::None, Verdict::from),
+        candidates: Vec::new(),
+        clear_leader: clear_leader(monitor.latest_scores(), &monitor.decision_rule()),
+    }
 }
 
 /// What the pipeline produces.
@@ -429,6 +448,7 @@ impl Pipeline {
                             freqs: *c.monitor.frequencies(),
                             bands: [bands[0], bands[1], bands[2]],
                             samples: c.monitor.recent_samples((twin_window_s * fs) as usize),
+                            envelope: envelope_view(&c.monitor),
                         }));
                     }
                 }

@@ -1,12 +1,17 @@
 //! The twin's periodic re-fit, on its own thread (FFT-heavy work never runs on the async
 //! side), warm-started per channel from the previous fit: the signal-model twin on the
 //! envelope spectrum and, on the newest samples of the same signal, the Hammerstein–Wiener
-//! model of seed 003 with its drift against the channel's baseline (`twin::hw::online`).
+//! model of seed 003 with its drift against the channel's baseline (`twin::hw::online`); and,
+//! when a learned model is configured, its opinion of the same signal combined with the
+//! envelope evidence the request carries (`learned`), logged with the twin's fit.
 
 use super::TwinRequest;
 use crate::analysis::envelope::{window_samples, FftPlans};
 use crate::config::TwinConfig;
-use crate::messages::{ChannelId, HwMessage, PipelineMessage, TwinMessage};
+use crate::learned::{combine, Basis, LearnedModel, ModelError};
+use crate::messages::{
+    ChannelId, ClassProbability, HwMessage, LearnedOpinionMessage, PipelineMessage, TwinMessage,
+};
 use crate::twin::diagnose::fit_record;
 use crate::twin::hw::{HwConfig, HwError, HwTracker, HwUpdate};
 use crate::twin::{TwinFitter, TwinParams};
@@ -20,6 +25,8 @@ pub struct TwinWorker {
     /// The HW model's settings; `None`: off (`twin.hw_enabled = false`).
     hw: Option<HwSettings>,
     hw_trackers: BTreeMap<ChannelId, HwTracker>,
+    /// `twin.learned_model`, loaded.
+    learned: Option<LearnedModel>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -33,8 +40,15 @@ struct HwSettings {
 const WINDOW_FRACTION: f64 = 0.25;
 
 impl TwinWorker {
-    pub fn new(config: &TwinConfig) -> Self {
-        TwinWorker {
+    /// Loads the learned model if one is configured (its bearing was checked against the
+    /// sensors' when the config was validated).
+    pub fn new(config: &TwinConfig) -> Result<Self, ModelError> {
+        let learned = config
+            .learned_model
+            .as_deref()
+            .map(LearnedModel::load)
+            .transpose()?;
+        Ok(TwinWorker {
             plans: FftPlans::default(),
             fitter: TwinFitter::default(),
             previous: BTreeMap::new(),
@@ -44,7 +58,8 @@ impl TwinWorker {
                 baseline_fits: config.hw_baseline_fits,
             }),
             hw_trackers: BTreeMap::new(),
-        }
+            learned,
+        })
     }
 
     /// Both models on one request, each handed to `out` as soon as it is made: the twin's fit
@@ -125,6 +140,44 @@ impl TwinWorker {
                 .zip(&twin.twin)
                 .map(|(m, t)| (m - t) as f32)
                 .collect(),
+            learned: self.learned_opinion(request),
+        })
+    }
+
+    /// The learned model's opinion of the request's signal, combined with its envelope
+    /// evidence; `None` when no model is configured or the signal is shorter than a segment.
+    fn learned_opinion(&self, request: &TwinRequest) -> Option<LearnedOpinionMessage> {
+        let model = self.learned.as_ref()?;
+        let opinion =
+            match model.opinion_of_checked(&request.samples, request.fs_hz, request.freqs.shaft) {
+                Ok(opinion) if opinion.segments > 0 => opinion,
+                Ok(_) => return None,
+                Err(e) => {
+                    return Some(LearnedOpinionMessage {
+                        segments: 0,
+                        probabilities: Vec::new(),
+                        confirms: None,
+                        agrees: false,
+                        problem: Some(e.to_string()),
+                    })
+                }
+            };
+        let combined = combine(&request.envelope, &opinion);
+        Some(LearnedOpinionMessage {
+            segments: opinion.segments,
+            probabilities: opinion
+                .probabilities
+                .iter()
+                .map(|&(class, probability)| ClassProbability {
+                    fault: class.kind(),
+                    probability,
+                })
+                .collect(),
+            confirms: (combined.basis == Basis::EnvelopeConfirmedByLearned)
+                .then(|| combined.verdict.fault())
+                .flatten(),
+            agrees: combined.learned_agrees,
+            problem: None,
         })
     }
 }

@@ -17,6 +17,7 @@ use crate::analysis::indicators::Indicators;
 use crate::analysis::iso::VelocitySeverity;
 use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::bearing::BearingGeometry;
+use crate::learned::{Basis, Combined, LearnedOpinion};
 use crate::messages::FaultKind;
 use crate::twin::diagnose::{ResidualSummary, TwinDiagnosis};
 use crate::twin::{HypothesisFit, TwinParams};
@@ -123,7 +124,21 @@ pub struct AnalyzeReport {
     /// The signal-model twin's fit (`analyze --twin`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub twin: Option<TwinReport>,
+    /// The learned model's opinion and the combined diagnosis (`analyze --learned`); the
+    /// report's `diagnosis` is then the combined one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub learned: Option<LearnedReport>,
     pub warnings: Vec<String>,
+}
+
+/// The learned model's part of a report.
+#[derive(Debug, Clone, Serialize)]
+pub struct LearnedReport {
+    pub opinion: LearnedOpinion,
+    /// What the envelope diagnosis alone said.
+    pub envelope_diagnosis: &'static str,
+    pub basis: Basis,
+    pub learned_agrees: bool,
 }
 
 /// The twin's errors per hypothesis.
@@ -194,6 +209,24 @@ fn band_pair(band: crate::analysis::Band) -> [f64; 2] {
 }
 
 impl AnalyzeReport {
+    /// Adds the learned opinion; the diagnosis becomes the combined one.
+    pub fn set_learned(&mut self, opinion: LearnedOpinion, combined: Combined) {
+        let envelope_diagnosis = self.diagnosis;
+        self.diagnosis = combined.verdict.name();
+        if combined.basis == Basis::EnvelopeConfirmedByLearned {
+            self.reason = combined.reason;
+            self.candidates.clear();
+        } else {
+            self.reason = format!("{}; {}", self.reason, combined.reason);
+        }
+        self.learned = Some(LearnedReport {
+            opinion,
+            envelope_diagnosis,
+            basis: combined.basis,
+            learned_agrees: combined.learned_agrees,
+        });
+    }
+
     pub fn new(
         context: &RecordContext,
         analysis: &RecordAnalysis,
@@ -282,6 +315,7 @@ impl AnalyzeReport {
                 .collect(),
             velocity: None,
             twin: None,
+            learned: None,
             warnings: context.warnings.clone(),
         }
     }

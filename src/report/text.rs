@@ -99,6 +99,22 @@ pub fn render_text(r: &AnalyzeReport) -> String {
         );
         let _ = writeln!(out, "    {}", t.note);
     }
+    if let Some(l) = &r.learned {
+        let probabilities: Vec<String> = l
+            .opinion
+            .probabilities
+            .iter()
+            .map(|(class, p)| format!("{} {:.0} %", class.name(), 100.0 * p))
+            .collect();
+        let _ = writeln!(
+            out,
+            "  learned ({}, {} segments): {}; the envelope alone: {}",
+            l.opinion.model,
+            l.opinion.segments,
+            probabilities.join(", "),
+            l.envelope_diagnosis
+        );
+    }
     let i = &r.indicators;
     let _ = writeln!(
         out,

@@ -3,6 +3,7 @@
 //! envelope spectrum in closed form; and its fit to measured spectra, per fault hypothesis.
 //! The physics twin (MODELS.md §5, [`physics`]): the 6-DOF contact model and its calibration.
 
+pub mod dataset;
 pub mod diagnose;
 pub mod fit;
 pub mod hw;

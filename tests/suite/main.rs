@@ -11,6 +11,7 @@ mod envelope;
 mod fleet;
 mod formats;
 mod kinematics;
+mod learned;
 mod monitor;
 mod physics;
 mod replay;

@@ -257,6 +257,21 @@ impl BearingGeometry {
             two_bsf: 2.0 * bsf,
         }
     }
+
+    /// The text [`BearingGeometry::parse`] reads back as this bearing: its catalog name when it
+    /// is the catalog's entry, else the custom form `z=9,d=7.94mm,D=39.04mm,alpha=0`.
+    pub fn spec(&self) -> String {
+        match BearingGeometry::from_catalog(&self.name) {
+            Ok(entry) if entry == *self => self.name.clone(),
+            _ => format!(
+                "z={},d={}mm,D={}mm,alpha={}",
+                self.rolling_elements,
+                self.element_diameter_mm,
+                self.pitch_diameter_mm,
+                self.contact_angle_deg
+            ),
+        }
+    }
 }
 
 impl fmt::Display for BearingGeometry {

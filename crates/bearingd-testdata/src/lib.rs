@@ -45,7 +45,7 @@ pub fn shared_data_dir(kind: &str) -> Option<PathBuf> {
 }
 
 /// The root of the bearingd repository (this crate lives in `crates/bearingd-testdata`).
-fn repo_root() -> PathBuf {
+pub fn repo_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
 }
 

@@ -313,7 +313,7 @@ impl Checker {
     }
 
     /// `Some(None)`: absent; `None`: a problem was reported.
-    fn optional_text(
+    pub(super) fn optional_text(
         &mut self,
         key: &str,
         field: &Field<String>,

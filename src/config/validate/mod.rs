@@ -48,7 +48,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
     let mut check = Checker::default();
     let sensors = check.sensors(&raw.sensors);
     let analysis = check.analysis(&raw.analysis, &sensors);
-    let twin = check.twin(&raw.twin);
+    let twin = check.twin(&raw.twin, &sensors);
     let thresholds = check.thresholds(&raw.thresholds);
     let outputs = check.outputs(&raw.outputs, &sensors);
     let fleet = check.fleet(&raw.fleet, outputs.as_ref().map(|o| o.state_dir.as_path()));

@@ -3,7 +3,7 @@
 use super::*;
 
 impl Checker {
-    pub(super) fn twin(&mut self, raw: &RawTwin) -> Option<TwinConfig> {
+    pub(super) fn twin(&mut self, raw: &RawTwin, sensors: &[CheckedSensor]) -> Option<TwinConfig> {
         let d = TwinConfig::default();
         let refit_period_s = self.number(
             "twin.refit_period_s",
@@ -49,6 +49,7 @@ impl Checker {
             10_000,
             "give how many HW fits form the healthy baseline, e.g. hw_baseline_fits = 10",
         );
+        let learned_model = self.learned_model(&raw.learned_model, sensors);
         Some(TwinConfig {
             refit_period_s: refit_period_s?,
             window_s: window_s?,
@@ -56,6 +57,36 @@ impl Checker {
             hw_order: usize::try_from(hw_order?).ok()?,
             hw_samples: usize::try_from(hw_samples?).ok()?,
             hw_baseline_fits: u64::try_from(hw_baseline_fits?).ok()?,
+            learned_model: learned_model?,
         })
+    }
+
+    /// The learned model must load and know every sensor's bearing.
+    fn learned_model(
+        &mut self,
+        field: &Field<String>,
+        sensors: &[CheckedSensor],
+    ) -> Option<Option<PathBuf>> {
+        let key = "twin.learned_model";
+        let fix = "give a model file of `bearingd train`, e.g. learned_model = \
+                   \"/usr/share/bearingd/skf-6205-2rs.safetensors\", or remove the key";
+        let Some(path) = self.optional_text(key, field, fix)?.map(PathBuf::from) else {
+            return Some(None);
+        };
+        let model = match crate::learned::LearnedModel::load(&path) {
+            Ok(model) => model,
+            Err(e) => {
+                self.problem(key, format!("{e}"));
+                return None;
+            }
+        };
+        let mut fits = true;
+        for sensor in sensors.iter().filter_map(|s| s.config.as_ref()) {
+            if let Err(e) = model.check_bearing(&sensor.bearing) {
+                self.problem(key, format!("sensor {}: {e}", sensor.id));
+                fits = false;
+            }
+        }
+        fits.then_some(Some(path))
     }
 }

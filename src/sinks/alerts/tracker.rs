@@ -370,6 +370,7 @@ mod tests {
             residual_peak_hz: 10.0,
             residual_bin_hz: 1.0,
             residual: vec![],
+            learned: None,
         };
         let raise = flag("radial", OuterRace, OK, Watch, 10);
         let mut plain = tracker(16);

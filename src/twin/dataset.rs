@@ -10,6 +10,9 @@ use crate::twin::physics::{PhysicsModel, PhysicsParams};
 use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
 use serde::{Deserialize, Serialize};
 
+/// The signal model's resonance when the spec gives none (the simulator's example).
+const DEFAULT_RESONANCE_HZ: f64 = 3_000.0;
+
 /// Which model makes the records.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -57,6 +60,10 @@ pub struct DatasetSpec {
     /// gear mesh, random impulses, a 100 Hz tone).
     #[serde(default)]
     pub nuisance: bool,
+    /// Signal model: the structural resonance the impacts ring, Hz (optional; 3 kHz when
+    /// absent). A range makes the set cover machines with other resonances.
+    #[serde(default)]
+    pub resonance_hz: Option<[f64; 2]>,
 }
 
 /// One record of a set: its label and the conditions drawn for it.
@@ -73,6 +80,8 @@ pub struct DatasetRecord {
     pub severity: f64,
     /// Radial load, N (physics model; 0 for the signal model).
     pub load_n: f64,
+    /// The resonance, Hz (signal model; 0 for the physics model).
+    pub resonance_hz: f64,
     /// The record's own seed (noise, slip).
     pub seed: u64,
 }
@@ -129,6 +138,11 @@ impl DatasetSpec {
             ("amplitude_g", self.amplitude_g, 0.0),
             ("defect_width_mm", self.defect_width_mm, f64::MIN_POSITIVE),
             ("load_n", self.load_n, f64::MIN_POSITIVE),
+            (
+                "resonance_hz",
+                self.resonance_hz.unwrap_or([DEFAULT_RESONANCE_HZ; 2]),
+                f64::MIN_POSITIVE,
+            ),
         ];
         for (key, [lo, hi], least) in ranges {
             check(
@@ -154,6 +168,11 @@ impl DatasetSpec {
                     DatasetModel::Signal => (draw(self.amplitude_g), 0.0),
                     DatasetModel::Physics => (draw(self.defect_width_mm), draw(self.load_n)),
                 };
+                let resonance_hz = match (self.model, self.resonance_hz) {
+                    (DatasetModel::Signal, Some(range)) => draw(range),
+                    (DatasetModel::Signal, None) => DEFAULT_RESONANCE_HZ,
+                    (DatasetModel::Physics, _) => 0.0,
+                };
                 records.push(DatasetRecord {
                     index,
                     fault,
@@ -167,6 +186,7 @@ impl DatasetSpec {
                         severity
                     },
                     load_n,
+                    resonance_hz,
                     seed,
                 });
             }
@@ -191,6 +211,7 @@ impl DatasetSpec {
                     } else {
                         Nuisance::none()
                     },
+                    resonance_hz: record.resonance_hz,
                     onset_s: 0.0,
                     ramp_s: 0.0,
                     seed: record.seed,

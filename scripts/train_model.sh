@@ -1,0 +1,15 @@
+#!/usr/bin/env bash
+# Makes the shipped learned model from nothing but the simulators: the two synthetic data sets
+# (signal model and physics twin) and the training, seeded. Usage:
+#   scripts/train_model.sh [OUT]      (default OUT: models/skf-6205-2rs.safetensors)
+# About a minute on two cores. CI runs it into target/ and checks the result is the committed
+# file, byte for byte (the same binary, seeds and thread count give the same weights).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+OUT=${1:-models/skf-6205-2rs.safetensors}
+BIN=${BEARINGD:-target/release/bearingd}
+WORK=target/learned-train
+rm -rf "$WORK" && mkdir -p "$WORK" "$(dirname "$OUT")"
+"$BIN" dataset --spec config/learned-train.toml --out "$WORK/signal"
+"$BIN" dataset --spec config/learned-train-physics.toml --out "$WORK/physics"
+"$BIN" train --dataset "$WORK/signal" --dataset "$WORK/physics" --epochs 30 --seed 1 --out "$OUT"
