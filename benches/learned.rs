@@ -1,5 +1,5 @@
 //! Speed of the learned diagnosis (issue 14: inference ≤ 1 ms per window on one core),
-//! reported in docs/PHYSICS.md §6 and docs/PERFORMANCE.md:
+//! reported in docs/PHYSICS.md, "Learned diagnosis" and docs/PERFORMANCE.md:
 //! - the input of one segment (24 revolutions' envelope spectrum on the order axis);
 //! - the network on one segment (autoencoder + CNN);
 //! - the whole opinion of a 10 s record (its segments, batched).

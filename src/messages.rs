@@ -273,8 +273,8 @@ pub struct TwinMessage {
 }
 
 /// A learned model's opinion of a twin re-fit's signal, and what it settles with the envelope
-/// evidence (docs/PHYSICS.md §6): it may confirm the fault the envelope ranks first (clearly and
-/// significantly) while no flag names one; the flags stay the envelope's.
+/// evidence (docs/PHYSICS.md, "Learned diagnosis"): it may confirm the fault the envelope ranks
+/// first (clearly and significantly) while no flag names one; the flags stay the envelope's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct LearnedOpinionMessage {
     pub segments: usize,

@@ -233,7 +233,7 @@ pub struct TwinConfig {
     #[serde(default = "default_hw_baseline_fits")]
     pub hw_baseline_fits: u64,
     /// A learned model (`bearingd train`) whose opinion of each re-fit's signal is logged with
-    /// the twin's fit, combined with the envelope evidence (docs/PHYSICS.md §6); none: off.
+    /// the twin's fit, combined with the envelope evidence (docs/PHYSICS.md, "Learned diagnosis"); none: off.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub learned_model: Option<std::path::PathBuf>,
 }

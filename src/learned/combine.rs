@@ -22,8 +22,9 @@ use crate::analysis::fault_bands::FaultScore;
 use crate::messages::FaultKind;
 use serde::Serialize;
 
-/// (choice) How sure the network must be to settle an open case: on the CWRU developer set
-/// the network's wrong answers on faulty records stay below this (docs/PHYSICS.md §6).
+/// (choice, made before any test set was run) How sure the network must be to settle an open
+/// case. It is not what keeps the network's confident mistakes out: on CWRU ball record 224 it
+/// is 99 % sure of the inner race; the envelope's separation condition (rule 3) is.
 pub const CONFIRM_PROBABILITY: f64 = 0.9;
 
 /// What the envelope diagnosis says of a record, as far as the combination needs it.
