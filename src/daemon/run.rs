@@ -510,6 +510,7 @@ fn refit_thread(
     requests: &TwinRequestQueue,
     fits: &mpsc::SyncSender<PipelineMessage>,
 ) -> u64 {
+    crate::pipeline::priority::lower_this_thread();
     let mut made = 0u64;
     let mut open = true;
     while open {

@@ -14,6 +14,7 @@
 //! (the MCAP log, the command line's flag printer), and the pipeline knows none of them.
 
 pub mod bands;
+pub mod priority;
 pub mod refit;
 mod sink;
 pub mod twin_queue;
