@@ -360,6 +360,13 @@ pub fn analyze(
             &request.settings.decision_rule(),
         );
         let combined = combine_learned(&view, &opinion);
+        if opinion.segments == 0 {
+            let segment = model.card.features.segment_revolutions;
+            report.warnings.push(format!(
+                "no learned opinion: the record is shorter than one segment of {segment} shaft revolutions ({:.2} s at {rpm:.0} rpm)",
+                segment * 60.0 / rpm
+            ));
+        }
         report.set_learned(opinion, combined);
     }
     Ok(AnalyzeOutcome {

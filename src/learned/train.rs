@@ -171,7 +171,7 @@ impl TrainingSet {
             .outer_iter()
             .collect::<Vec<_>>()
             .par_iter()
-            .zip(rpm.as_slice().unwrap_or(&[]).par_iter())
+            .zip(rpm.to_vec().par_iter())
             .map(|(row, &rpm)| {
                 let samples: Vec<f32> = row.iter().copied().collect();
                 features.record_inputs(&mut FftPlans::default(), &samples, fs_hz, rpm / 60.0)

@@ -99,7 +99,7 @@ pub fn render_text(r: &AnalyzeReport) -> String {
         );
         let _ = writeln!(out, "    {}", t.note);
     }
-    if let Some(l) = &r.learned {
+    if let Some(l) = r.learned.as_ref().filter(|l| l.opinion.segments > 0) {
         let probabilities: Vec<String> = l
             .opinion
             .probabilities
