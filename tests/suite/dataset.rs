@@ -23,7 +23,8 @@ defect_width_mm = [0.178, 0.533]
 load_n = [500, 2000]
 "#;
 
-fn make(dir: &Path, name: &str, spec: &str, mcap: bool) -> std::path::PathBuf {
+/// Writes `spec` as `dir/NAME.toml` and runs `bearingd dataset` on it into `dir/NAME`.
+pub fn make(dir: &Path, name: &str, spec: &str, mcap: bool) -> std::path::PathBuf {
     let spec_path = dir.join(format!("{name}.toml"));
     std::fs::write(&spec_path, spec).unwrap();
     let out = dir.join(name);

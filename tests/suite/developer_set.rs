@@ -11,7 +11,8 @@ use bearingd::offline::{analyze, AnalyzeRequest};
 use bearingd::recording::ReadOptions;
 use bearingd_testdata::{read_manifest, shared_data_dir};
 
-fn expected_class(fault: &str) -> &'static str {
+/// The class a manifest's `fault` column names.
+pub fn expected_class(fault: &str) -> &'static str {
     match fault {
         "inner" => "inner_race",
         "outer" => "outer_race",

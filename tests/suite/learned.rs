@@ -5,6 +5,8 @@
 //! with the fix.
 
 use crate::cli::{bearingd, stderr};
+use crate::dataset::make;
+use crate::developer_set::expected_class;
 use crate::replay::replay_json;
 use bearingd::analysis::record::RecordAnalyzer;
 use bearingd::learned::{Basis, LearnedModel};
@@ -37,17 +39,7 @@ nuisance = true
 #[test]
 fn a_tiny_training_run_learns_to_tell_faults_apart() {
     let dir = scratch_dir("learned-tiny");
-    let spec = dir.join("tiny.toml");
-    std::fs::write(&spec, TINY_SPEC).unwrap();
-    let set = dir.join("set");
-    let made = bearingd(&[
-        "dataset",
-        "--spec",
-        spec.to_str().unwrap(),
-        "--out",
-        set.to_str().unwrap(),
-    ]);
-    assert!(made.status.success(), "{}", stderr(&made));
+    let set = make(&dir, "tiny", TINY_SPEC, false);
     let model_path = dir.join("tiny.safetensors");
     let trained = bearingd(&[
         "train",
@@ -93,15 +85,6 @@ fn a_tiny_training_run_learns_to_tell_faults_apart() {
 
 fn shipped_model() -> Arc<LearnedModel> {
     Arc::new(LearnedModel::load(&repo_root().join("models/skf-6205-2rs.safetensors")).unwrap())
-}
-
-fn expected_class(fault: &str) -> &'static str {
-    match fault {
-        "inner" => "inner_race",
-        "outer" => "outer_race",
-        "ball" => "ball",
-        _ => "none",
-    }
 }
 
 #[test]
@@ -186,28 +169,14 @@ fn a_model_file_that_does_not_apply_is_refused_with_the_fix() {
 #[test]
 fn the_daemon_logs_the_learned_opinion_with_each_twin_fit() {
     let dir = scratch_dir("learned-daemon");
-    let spec = dir.join("one.toml");
-    std::fs::write(
-        &spec,
-        TINY_SPEC
-            .replace(
-                "faults = [\"none\", \"outer_race\", \"inner_race\"]",
-                "faults = [\"outer_race\"]",
-            )
-            .replace("records_per_fault = 20", "records_per_fault = 1")
-            .replace("duration_s = 2.0", "duration_s = 30.0"),
-    )
-    .unwrap();
-    let set = dir.join("set");
-    let made = bearingd(&[
-        "dataset",
-        "--spec",
-        spec.to_str().unwrap(),
-        "--out",
-        set.to_str().unwrap(),
-        "--mcap",
-    ]);
-    assert!(made.status.success(), "{}", stderr(&made));
+    let one_record = TINY_SPEC
+        .replace(
+            "faults = [\"none\", \"outer_race\", \"inner_race\"]",
+            "faults = [\"outer_race\"]",
+        )
+        .replace("records_per_fault = 20", "records_per_fault = 1")
+        .replace("duration_s = 2.0", "duration_s = 30.0");
+    let set = make(&dir, "one", &one_record, true);
     let record = set.join("mcap/00000");
     let model = repo_root().join("models/skf-6205-2rs.safetensors");
     let config = record.join("replay.toml");
