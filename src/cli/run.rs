@@ -140,10 +140,10 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         summary.twin_fits,
         summary.twin_requests_skipped,
         summary.alerts_published,
-        if summary.alerts_dropped > 0 {
+        if summary.alerts_failed > 0 {
             format!(
-                " ({} DROPPED: the alert queue was full)",
-                summary.alerts_dropped
+                " ({} NOT PUBLISHED: iceoryx2 refused them, see the errors above)",
+                summary.alerts_failed
             )
         } else {
             String::new()
@@ -284,8 +284,6 @@ pub(super) fn event_line(event: &DaemonEvent) -> String {
         DaemonEvent::NoAlertService => {
             "bearingd: built without the `shm` feature: no iceoryx2 alerts are published".into()
         }
-        #[cfg(feature = "shm")]
-        DaemonEvent::AlertDropped(dropped) => format!("bearingd: {dropped}"),
         #[cfg(feature = "shm")]
         DaemonEvent::AlertFailed(error) => format!("bearingd: {error}"),
         DaemonEvent::TwinFitDropped {

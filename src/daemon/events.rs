@@ -7,7 +7,7 @@ use crate::mcap_log::McapLogError;
 use crate::messages::ChannelId;
 use crate::pipeline::ChannelStatus;
 #[cfg(feature = "shm")]
-use crate::sinks::alerts::{AlertDropped, AlertError};
+use crate::sinks::alerts::AlertError;
 use crate::sinks::mcap::{LogNotice, RecoveryReport};
 use crate::sinks::systemd::NotifyError;
 use std::path::PathBuf;
@@ -49,10 +49,7 @@ pub enum DaemonEvent {
     DeadIoxNodesUnknown(String),
     /// This bearingd was built without iceoryx2: flags go to the log only.
     NoAlertService,
-    /// An alert found the publisher's queue full.
-    #[cfg(feature = "shm")]
-    AlertDropped(AlertDropped),
-    /// The publisher thread could not publish an alert.
+    /// iceoryx2 refused an alert.
     #[cfg(feature = "shm")]
     AlertFailed(AlertError),
     /// A twin re-fit request of `channel` (its window ending at `dropped_end_sample`) was

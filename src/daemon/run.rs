@@ -10,17 +10,17 @@
 //!   slowed; a transport source then backs up into its own buffer, where a loss shows as an
 //!   exact sequence gap.
 //! - analysis thread ([`AnalysisThread`]): owns the [`Pipeline`] and the alert sink; hands
-//!   messages to the sink queue (`Block`), flag changes straight to the alert publisher
-//!   (`DropNewest`, counted and reported; alerts are rare), and twin requests to the re-fit
+//!   messages to the sink queue (`Block`), publishes the alerts of flag changes itself
+//!   (iceoryx2's send does not block), and hands twin requests to the re-fit
 //!   hand-over ([`crate::pipeline::twin_queue`]: one slot per channel, served in turn; a request
 //!   still waiting when its channel asks again is dropped, counted and reported). Band
 //!   selections run on the pipeline's own worker thread ([`crate::pipeline::bands`]). Each input carries the wall-clock time its
 //!   source completed it ([`Arrived`]); alerts carry that time of the block that decided them,
 //!   so their latency includes any wait in the queue. The analysis never sees it. After every
 //!   input it publishes the channels' status on a `watch` channel (the latest value only).
-//! - alert thread: the iceoryx2 publisher of `outputs.alerts_service`
-//!   ([`crate::sinks::alerts`]). Alerts skip the sink queue so that MCAP compression never
-//!   delays them.
+//! - alert keeper thread: updates the alert publisher's connections, so that a late
+//!   subscriber is handed the history ([`crate::sinks::alerts::service`]). Alerts skip the
+//!   sink queue so that MCAP compression never delays them.
 //! - re-fit thread: [`TwinWorker`]; its fits (the twin's, then the HW model's) go back to the
 //!   analysis thread through a bounded hand-over (two slots per channel, plus two; the re-fit
 //!   thread waits when it is full), and
@@ -115,8 +115,8 @@ pub struct RunSummary {
     pub twin_requests_skipped: u64,
     /// Alerts published on the iceoryx2 alert service.
     pub alerts_published: u64,
-    /// Alerts that found the alert queue full (reported as they happen).
-    pub alerts_dropped: u64,
+    /// Alerts iceoryx2 refused (reported as they happen).
+    pub alerts_failed: u64,
 }
 
 /// Inputs waiting for the analysis thread, at most.
@@ -228,7 +228,7 @@ pub async fn run(
         twin_fits,
         twin_requests_skipped: analysis.requests_skipped,
         alerts_published: analysis.alerts.map_or(0, |s| s.published),
-        alerts_dropped: analysis.alerts.map_or(0, |s| s.dropped),
+        alerts_failed: analysis.alerts.map_or(0, |s| s.failed),
     })
 }
 
@@ -323,11 +323,7 @@ fn start_alerts(config: &Config, events: &Events) -> Result<Option<AlertSink>, R
         }
         Err(e) => events(DaemonEvent::DeadIoxNodesUnknown(e.to_string())),
     }
-    let on_failure = {
-        let events = events.clone();
-        move |e| events(DaemonEvent::AlertFailed(e))
-    };
-    let alerts = AlertSink::start(config, iox, wall_clock_now_ns(), on_failure)?;
+    let alerts = AlertSink::start(config, iox, wall_clock_now_ns())?;
     events(DaemonEvent::AlertsOn {
         service: config.outputs.alerts_service.clone(),
         root: config.outputs.iceoryx2_root.clone(),
@@ -441,11 +437,11 @@ impl AnalysisThread {
         pipeline.handle(arrived.input, &mut |output| match output {
             Output::Message(message) => {
                 if let Some(alerts) = alerts.as_mut() {
-                    alerts.observe(&message, arrived.wall_ns, &mut |dropped| {
+                    alerts.observe(&message, arrived.wall_ns, &mut |failed| {
                         #[cfg(feature = "shm")]
-                        events(DaemonEvent::AlertDropped(dropped));
+                        events(DaemonEvent::AlertFailed(failed));
                         #[cfg(not(feature = "shm"))]
-                        let _ = (dropped, &events);
+                        let _ = (failed, &events);
                     });
                 }
                 let _ = sinks.send(message);

@@ -175,13 +175,17 @@ fn node_config(settings: &IoxSettings) -> Result<Config, ShmError> {
 }
 
 #[cfg(feature = "iceoryx2")]
-/// An iceoryx2 node with bearingd's settings.
-pub fn create_node(settings: &IoxSettings) -> Result<Node<ipc::Service>, ShmError> {
+/// An iceoryx2 node with bearingd's settings, of either variant: `ipc::Service` (ports stay
+/// on the thread that made them) or `ipc_threadsafe::Service` (ports shared between threads;
+/// the same shared memory, so either end may use the other variant).
+pub fn create_node<S: iceoryx2::service::Service>(
+    settings: &IoxSettings,
+) -> Result<Node<S>, ShmError> {
     let config = node_config(settings)?;
     NodeBuilder::new()
         .config(&config)
         .signal_handling_mode(SignalHandlingMode::Disabled)
-        .create::<ipc::Service>()
+        .create::<S>()
         .map_err(|e| ShmError::Node(format!("{e:?}")))
 }
 
@@ -218,10 +222,10 @@ pub fn open_data_service(
 
 #[cfg(feature = "iceoryx2")]
 /// An event service (wake-up or ready).
-pub fn open_event_service(
-    node: &Node<ipc::Service>,
+pub fn open_event_service<S: iceoryx2::service::Service>(
+    node: &Node<S>,
     name: &str,
-) -> Result<iceoryx2::service::port_factory::event::PortFactory<ipc::Service>, ShmError> {
+) -> Result<iceoryx2::service::port_factory::event::PortFactory<S>, ShmError> {
     node.service_builder(&service_name(name)?)
         .event()
         .open_or_create()

@@ -10,7 +10,8 @@
 //! - [`tracker`]: flag changes → alerts (sans-IO).
 //! - [`service`]: the iceoryx2 publisher and subscriber.
 //! - [`AlertSink`]: the tracker and the publisher as the daemon drives them, on the analysis
-//!   thread, so that alerts never wait behind the MCAP log.
+//!   thread: an alert leaves as soon as it is decided, never behind the MCAP log or another
+//!   thread's wake-up.
 
 pub mod payload;
 #[cfg(feature = "shm")]
@@ -19,20 +20,19 @@ pub mod tracker;
 
 pub use payload::{Alert, AlertState, AlertView};
 #[cfg(feature = "shm")]
-pub use service::{AlertDropped, AlertError, AlertPublisher, AlertServiceSettings};
+pub use service::{AlertError, AlertPublisher, AlertServiceSettings};
 pub use tracker::AlertTracker;
 
 /// What the daemon's alert publisher did, for its summary.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct PublisherSummary {
     pub published: u64,
-    /// Alerts that found the queue to the publisher thread full (never expected: alerts are
-    /// rare and the thread only copies them).
-    pub dropped: u64,
+    /// Alerts iceoryx2 refused to send (each reported as it happened).
+    pub failed: u64,
 }
 
 /// The alert service as the daemon drives it: the tracker (flag changes → alerts) and the
-/// publisher (its own thread) of `outputs.alerts_service`.
+/// publisher of `outputs.alerts_service`.
 #[cfg(feature = "shm")]
 pub struct AlertSink {
     tracker: AlertTracker,
@@ -42,36 +42,34 @@ pub struct AlertSink {
 #[cfg(feature = "shm")]
 impl AlertSink {
     /// Creates the service for `config`'s channels (a history deep enough for all of them, see
-    /// [`tracker::history_size_for`]) under `iox`; `run_id` numbers this daemon run; an alert
-    /// the publisher thread cannot publish goes to `on_failure`.
+    /// [`tracker::history_size_for`]) under `iox`; `run_id` numbers this daemon run.
     pub fn start(
         config: &crate::config::Config,
         iox: crate::iox::IoxSettings,
         run_id: u64,
-        on_failure: impl Fn(AlertError) + Send + 'static,
     ) -> Result<AlertSink, AlertError> {
         let history = tracker::history_size_for(config.channel_count());
         let settings = AlertServiceSettings {
             service: config.outputs.alerts_service.clone(),
             iox,
         };
-        let publisher = AlertPublisher::start(settings, history, on_failure)?;
+        let publisher = AlertPublisher::start(settings, history)?;
         let tracker = AlertTracker::new(run_id, history, &config.analysis, config.sample_rates());
         Ok(AlertSink { tracker, publisher })
     }
 
     /// Takes one pipeline message; publishes the alerts it causes, stamped `wall_time_ns`. An
-    /// alert that finds the publisher's queue full goes to `dropped`.
+    /// alert iceoryx2 refuses goes to `failed`.
     pub fn observe(
         &mut self,
         message: &crate::messages::PipelineMessage,
         wall_time_ns: u64,
-        dropped: &mut impl FnMut(AlertDropped),
+        failed: &mut impl FnMut(AlertError),
     ) {
-        let publisher = &self.publisher;
+        let publisher = &mut self.publisher;
         self.tracker.observe(message, wall_time_ns, &mut |alert| {
             if let Err(e) = publisher.send(alert) {
-                dropped(e);
+                failed(e);
             }
         });
     }
@@ -81,7 +79,7 @@ impl AlertSink {
         self.tracker.note_twin(fit);
     }
 
-    /// Publishes what is queued, closes the ports and reports.
+    /// Closes the ports and reports.
     pub fn finish(self) -> PublisherSummary {
         self.publisher.finish()
     }

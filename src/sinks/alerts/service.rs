@@ -1,5 +1,5 @@
-//! The iceoryx2 ends of the alert service: the daemon's publisher (on a thread of its own,
-//! fed through a bounded channel) and the subscriber that `bearingd alerts` and the tests use.
+//! The iceoryx2 ends of the alert service: the daemon's publisher and the subscriber that
+//! `bearingd alerts` and the tests use.
 //!
 //! Service shape (the publisher creates it; subscribers only open it, so a subscriber started
 //! first cannot create it with a shape the daemon would then refuse):
@@ -11,32 +11,36 @@
 //! - event `<alerts_service>/wake`, notified after every alert, so a subscriber sleeps in the
 //!   kernel instead of polling.
 //!
-//! iceoryx2 hands history to a new subscriber when the publisher next updates its
-//! connections; the publisher thread does that every [`CONNECTION_PERIOD`] while idle.
+//! The daemon publishes on the thread that decides the alert (the analysis thread): iceoryx2's
+//! send and notify never block, and no other thread has to wake up before the alert leaves.
+//! Its ports are therefore of the `ipc_threadsafe` variant (the same shared memory as the
+//! subscribers' `ipc`), shared with a keeper thread: iceoryx2 hands the history to a new
+//! subscriber when the publisher next updates its connections, and the keeper does that every
+//! [`CONNECTION_PERIOD`], also while no alert is sent.
 
 use super::payload::Alert;
 use super::PublisherSummary;
 use crate::iox::{create_node, open_event_service, wake_service, IoxSettings};
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// Alerts a subscriber's buffer holds before the oldest is overwritten.
 pub const SUBSCRIBER_BUFFER: usize = 256;
-/// How often an idle publisher looks for new subscribers (to hand them the history).
+/// How often the publisher looks for new subscribers (to hand them the history).
 pub const CONNECTION_PERIOD: Duration = Duration::from_millis(50);
-/// Alerts waiting between the analysis thread and the publisher thread.
-const QUEUE: usize = 256;
+
+/// The publisher's iceoryx2 variant: ports shared between the analysis and keeper threads.
+type Shared = ipc_threadsafe::Service;
 
 /// Why the alert service could not be used. Messages name the service and the root path.
 #[derive(Debug, thiserror::Error)]
 pub enum AlertError {
     #[error("alert service {service}: {detail}")]
     Service { service: String, detail: String },
-    #[error("alert publisher thread: {0}")]
+    #[error("alert keeper thread: {0}")]
     Thread(String),
     #[error("alert #{sequence} could not be published on {service}: {detail}")]
     Publish {
@@ -44,15 +48,6 @@ pub enum AlertError {
         service: String,
         detail: String,
     },
-}
-
-/// An alert that found the queue to the publisher thread full: not published.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
-#[error("alert #{sequence} not published: the alert queue is full ({dropped} dropped so far)")]
-pub struct AlertDropped {
-    pub sequence: u64,
-    /// Alerts dropped since the publisher started, this one included.
-    pub dropped: u64,
 }
 
 /// Where the alert service is.
@@ -80,80 +75,29 @@ impl AlertServiceSettings {
     }
 }
 
-/// The daemon's side: hand alerts to [`send`](Self::send); a thread publishes them.
+/// The daemon's side: [`send`](Self::send) publishes at once, on the caller's thread.
 pub struct AlertPublisher {
-    queue: mpsc::SyncSender<Alert>,
-    dropped: Arc<AtomicU64>,
-    thread: std::thread::JoinHandle<u64>,
+    settings: AlertServiceSettings,
+    publisher: Arc<iceoryx2::port::publisher::Publisher<Shared, Alert, ()>>,
+    wake: iceoryx2::port::notifier::Notifier<Shared>,
+    published: u64,
+    failed: u64,
+    /// Closing it ends the keeper thread.
+    stop_keeper: mpsc::SyncSender<()>,
+    keeper: std::thread::JoinHandle<()>,
+    // Declared after the ports: fields drop in order, the ports before their service and node.
+    _service: iceoryx2::service::port_factory::publish_subscribe::PortFactory<Shared, Alert, ()>,
+    _node: Node<Shared>,
 }
 
 impl AlertPublisher {
-    /// Creates the services and the publisher on a new thread; returns once they exist, or
-    /// with the reason they could not be created. An alert the thread then fails to publish
-    /// goes to `on_failure` (the daemon reports it) and the thread goes on.
+    /// Creates the services, the publisher and its keeper thread; or says why it could not.
     pub fn start(
         settings: AlertServiceSettings,
         history_size: usize,
-        on_failure: impl Fn(AlertError) + Send + 'static,
     ) -> Result<AlertPublisher, AlertError> {
-        let (queue, alerts) = mpsc::sync_channel::<Alert>(QUEUE);
-        let (started_tx, started_rx) = mpsc::sync_channel::<Result<(), AlertError>>(1);
-        let thread = std::thread::Builder::new()
-            .name("bearingd-alerts".into())
-            .spawn(move || {
-                publisher_thread(&settings, history_size, &alerts, &started_tx, &on_failure)
-            })
-            .map_err(|e| AlertError::Thread(e.to_string()))?;
-        match started_rx.recv() {
-            Ok(Ok(())) => Ok(AlertPublisher {
-                queue,
-                dropped: Arc::default(),
-                thread,
-            }),
-            Ok(Err(e)) => {
-                let _ = thread.join();
-                Err(e)
-            }
-            Err(_) => {
-                let _ = thread.join();
-                Err(AlertError::Thread("ended before its ports existed".into()))
-            }
-        }
-    }
-
-    /// Queues one alert for publishing; a full queue counts the alert as dropped and says so
-    /// in the error.
-    pub fn send(&self, alert: Alert) -> Result<(), AlertDropped> {
-        if self.queue.try_send(alert).is_err() {
-            let dropped = self.dropped.fetch_add(1, Ordering::Relaxed) + 1;
-            return Err(AlertDropped {
-                sequence: alert.sequence,
-                dropped,
-            });
-        }
-        Ok(())
-    }
-
-    /// Publishes what is queued, closes the ports and reports.
-    pub fn finish(self) -> PublisherSummary {
-        drop(self.queue);
-        let published = self.thread.join().unwrap_or(0);
-        PublisherSummary {
-            published,
-            dropped: self.dropped.load(Ordering::Relaxed),
-        }
-    }
-}
-
-fn publisher_thread(
-    settings: &AlertServiceSettings,
-    history_size: usize,
-    alerts: &mpsc::Receiver<Alert>,
-    started: &mpsc::SyncSender<Result<(), AlertError>>,
-    on_failure: &impl Fn(AlertError),
-) -> u64 {
-    let setup = (|| {
-        let node = create_node(&settings.iox).map_err(|e| settings.error(e.to_string()))?;
+        let node =
+            create_node::<Shared>(&settings.iox).map_err(|e| settings.error(e.to_string()))?;
         let service = node
             .service_builder(&settings.service_name()?)
             .publish_subscribe::<Alert>()
@@ -169,45 +113,70 @@ fn publisher_thread(
                      each its own outputs.alerts_service"
                 ))
             })?;
-        let publisher = service
-            .publisher_builder()
-            .create()
-            .map_err(|e| settings.error(format!("create publisher: {e:?}")))?;
+        let publisher = Arc::new(
+            service
+                .publisher_builder()
+                .create()
+                .map_err(|e| settings.error(format!("create publisher: {e:?}")))?,
+        );
         let wake = open_event_service(&node, &settings.wake_name())
             .map_err(|e| settings.error(e.to_string()))?
             .notifier_builder()
             .create()
             .map_err(|e| settings.error(format!("create notifier: {e:?}")))?;
-        Ok((node, service, publisher, wake))
-    })();
-    let (_node, _service, publisher, wake) = match setup {
-        Ok(ports) => {
-            let _ = started.send(Ok(()));
-            ports
-        }
-        Err(e) => {
-            let _ = started.send(Err(e));
-            return 0;
-        }
-    };
-    let mut published = 0u64;
-    loop {
-        match alerts.recv_timeout(CONNECTION_PERIOD) {
-            Ok(alert) => match publisher.send_copy(alert) {
-                Ok(_) => {
-                    published += 1;
-                    let _ = wake.notify();
-                }
-                Err(e) => on_failure(AlertError::Publish {
-                    sequence: alert.sequence,
-                    service: settings.service.clone(),
-                    detail: format!("{e:?}"),
-                }),
-            },
-            Err(mpsc::RecvTimeoutError::Timeout) => {
-                let _ = publisher.update_connections();
+        let (stop_keeper, stopped) = mpsc::sync_channel::<()>(0);
+        let keeper = {
+            let publisher = Arc::clone(&publisher);
+            std::thread::Builder::new()
+                .name("bearingd-alerts".into())
+                .spawn(move || {
+                    while let Err(mpsc::RecvTimeoutError::Timeout) =
+                        stopped.recv_timeout(CONNECTION_PERIOD)
+                    {
+                        let _ = publisher.update_connections();
+                    }
+                })
+                .map_err(|e| AlertError::Thread(e.to_string()))?
+        };
+        Ok(AlertPublisher {
+            settings,
+            publisher,
+            wake,
+            published: 0,
+            failed: 0,
+            stop_keeper,
+            keeper,
+            _service: service,
+            _node: node,
+        })
+    }
+
+    /// Publishes one alert and wakes the subscribers; the error names the alert and why.
+    pub fn send(&mut self, alert: Alert) -> Result<(), AlertError> {
+        match self.publisher.send_copy(alert) {
+            Ok(_) => {
+                self.published += 1;
+                let _ = self.wake.notify();
+                Ok(())
             }
-            Err(mpsc::RecvTimeoutError::Disconnected) => return published,
+            Err(e) => {
+                self.failed += 1;
+                Err(AlertError::Publish {
+                    sequence: alert.sequence,
+                    service: self.settings.service.clone(),
+                    detail: format!("{e:?}"),
+                })
+            }
+        }
+    }
+
+    /// Stops the keeper, closes the ports and reports.
+    pub fn finish(self) -> PublisherSummary {
+        drop(self.stop_keeper);
+        let _ = self.keeper.join();
+        PublisherSummary {
+            published: self.published,
+            failed: self.failed,
         }
     }
 }
@@ -398,21 +367,18 @@ mod tests {
     #[test]
     fn a_subscriber_that_falls_behind_is_told_which_alerts_it_lost() {
         let settings = settings("lost");
-        let publisher = AlertPublisher::start(settings.clone(), 16, |e| eprintln!("{e}")).unwrap();
+        let mut publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
         let mut subscriber = AlertSubscriber::open(&settings).unwrap();
         assert!(subscriber
             .take_history(Duration::from_millis(300))
             .is_empty());
         let total = SUBSCRIBER_BUFFER as u64 + 44;
         for sequence in 1..=total {
-            let _ = publisher.send(alert(sequence));
-            if sequence % 64 == 0 {
-                std::thread::sleep(Duration::from_millis(20)); // let the thread keep up
-            }
+            publisher.send(alert(sequence)).unwrap();
         }
         let summary = publisher.finish();
         assert_eq!(summary.published, total);
-        assert_eq!(summary.dropped, 0);
+        assert_eq!(summary.failed, 0);
         let received = drain(&mut subscriber);
         // The buffer kept the newest alerts; the oldest were overwritten and are reported.
         assert_eq!(
@@ -436,9 +402,9 @@ mod tests {
     #[test]
     fn a_late_subscriber_receives_the_history_then_live_alerts_and_restarts() {
         let settings = settings("history");
-        let publisher = AlertPublisher::start(settings.clone(), 16, |e| eprintln!("{e}")).unwrap();
+        let mut publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
         for sequence in 1..=20 {
-            let _ = publisher.send(alert(sequence));
+            publisher.send(alert(sequence)).unwrap();
         }
         std::thread::sleep(Duration::from_millis(200));
         let mut subscriber = AlertSubscriber::open(&settings).unwrap();
@@ -451,19 +417,19 @@ mod tests {
             })
             .collect();
         assert_eq!(sequences, (5..=20).collect::<Vec<_>>(), "{history:?}");
-        let _ = publisher.send(alert(21));
+        publisher.send(alert(21)).unwrap();
         assert_eq!(
             subscriber.next(Duration::from_secs(5)),
             Some(Received::Alert(alert(21)))
         );
         // The daemon restarts: a new run id, numbers from 1 again.
         publisher.finish();
-        let publisher = AlertPublisher::start(settings.clone(), 16, |e| eprintln!("{e}")).unwrap();
+        let mut publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
         let restarted = Alert {
             run_id: 43,
             ..alert(1)
         };
-        let _ = publisher.send(restarted);
+        publisher.send(restarted).unwrap();
         assert_eq!(
             subscriber.next(Duration::from_secs(5)),
             Some(Received::NewRun { run_id: 43 })
