@@ -385,14 +385,29 @@ pub struct EnvelopeUpdate<'a> {
     pub bin_hz: f64,
     /// How many windows the averages hold.
     pub windows_averaged: usize,
+    /// One engine per distinct band asked for ([`Self::band`] finds a band's engine).
     pub bands: &'a [RollingBand],
+    /// For each band asked for, in order, the index of its engine in `bands`.
+    pub band_of: &'a [usize],
     /// The raw samples of the newest window, oldest first, as two slices of the ring buffer.
     pub window_samples: (&'a [f32], &'a [f32]),
+    /// The real FFT of those samples (no window function), `window / 2 + 1` bins.
+    pub window_spectrum: &'a [Complex32],
+}
+
+impl EnvelopeUpdate<'_> {
+    /// The engine of the `i`-th band asked for.
+    pub fn band(&self, i: usize) -> Option<&RollingBand> {
+        self.band_of
+            .get(i)
+            .and_then(|&engine| self.bands.get(engine))
+    }
 }
 
 /// Rolling form: a ring buffer of the last window of samples; every hop, for each band, the
 /// envelope spectrum of the newest window and the average of the last `averages` windows. The
-/// window's FFT is shared by the bands.
+/// window's FFT is shared by the bands, and a band asked for twice (two faults whose best band
+/// is the same) is computed once.
 ///
 /// All memory is allocated in [`RollingEnvelope::new`] and [`RollingEnvelope::set_bands`];
 /// [`RollingEnvelope::push`] never allocates (tested with a counting allocator).
@@ -409,7 +424,10 @@ pub struct RollingEnvelope {
     phase: usize,
     samples_seen: u64,
     transform: WindowTransform,
+    /// One engine per distinct band.
     bands: Vec<RollingBand>,
+    /// For each band asked for, its engine.
+    band_of: Vec<usize>,
     history_used: usize,
     history_next: usize,
 }
@@ -436,6 +454,7 @@ impl RollingEnvelope {
             samples_seen: 0,
             transform,
             bands: Vec::new(),
+            band_of: Vec::new(),
             history_used: 0,
             history_next: 0,
         };
@@ -477,15 +496,23 @@ impl RollingEnvelope {
     pub fn set_bands(&mut self, bands: &[Band]) {
         let (bins, averages, window) = (self.spectrum_bins, self.averages, self.ring.len());
         let mut plans = FftPlans::shared();
-        self.bands = bands
-            .iter()
-            .map(|&band| RollingBand {
-                envelope: BandEnvelope::new(band, self.fs_hz, window, bins, &mut plans),
-                latest: vec![0.0; bins],
-                history: vec![0.0; averages * bins],
-                averaged: vec![0.0; bins],
-            })
-            .collect();
+        self.bands.clear();
+        self.band_of.clear();
+        for &band in bands {
+            let engine = match self.bands.iter().position(|b| b.band() == band) {
+                Some(engine) => engine,
+                None => {
+                    self.bands.push(RollingBand {
+                        envelope: BandEnvelope::new(band, self.fs_hz, window, bins, &mut plans),
+                        latest: vec![0.0; bins],
+                        history: vec![0.0; averages * bins],
+                        averaged: vec![0.0; bins],
+                    });
+                    self.bands.len() - 1
+                }
+            };
+            self.band_of.push(engine);
+        }
         self.history_used = 0;
         self.history_next = 0;
     }
@@ -549,7 +576,9 @@ impl RollingEnvelope {
             bin_hz: self.fs_hz / self.ring.len() as f64,
             windows_averaged: self.history_used,
             bands: &self.bands,
+            band_of: &self.band_of,
             window_samples: (older, newer),
+            window_spectrum: self.transform.spectrum(),
         });
     }
 }

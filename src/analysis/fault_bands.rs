@@ -172,20 +172,31 @@ struct CombLine {
     weight: f64,
 }
 
-/// Scores envelope spectra; owns its scratch space so that scoring never allocates once warm.
-pub struct FaultScorer {
-    tolerance: f64,
-    harmonics: usize,
-    /// Excess (log amplitude over the running-median floor) of the prepared spectrum.
+/// One spectrum made ready for scoring ([`FaultScorer::prepare`]): scored for every fault, and
+/// again on what the leader does not explain, it is prepared once.
+#[derive(Debug, Default)]
+struct Prepared {
+    /// Excess (log amplitude over the running-median floor); empty when there is nothing to
+    /// score.
     excess: Vec<f32>,
-    /// Bins the winner's comb explains, when scoring explained.
-    masked: Vec<bool>,
-    scratch: Vec<f32>,
-    knots: Vec<f32>,
     /// Robust spread (1.4826 × MAD) of `excess`.
     spread: f64,
     bin_hz: f64,
-    amplitude_len: usize,
+}
+
+/// Scores envelope spectra; owns its scratch space so that scoring never allocates once warm.
+/// Spectra are prepared into numbered slots (one per band a caller scores) and scored from
+/// there.
+pub struct FaultScorer {
+    tolerance: f64,
+    harmonics: usize,
+    spectrum_bins: usize,
+    slots: Vec<Prepared>,
+    /// Bins the winner's comb explains, when scoring explained.
+    masked: Vec<bool>,
+    /// Scratch for the medians.
+    keys: Vec<i32>,
+    knots: Vec<f32>,
 }
 
 /// Relative half-width of a line's search window beside the slip (bearing-geometry and
@@ -203,13 +214,17 @@ impl FaultScorer {
         FaultScorer {
             tolerance,
             harmonics: harmonics.clamp(1, MAX_HARMONICS),
-            excess: Vec::with_capacity(spectrum_bins),
+            spectrum_bins,
+            // One per fault's band, as the daemon scores them; more are made on first use.
+            slots: (0..FaultKind::ALL.len())
+                .map(|_| Prepared {
+                    excess: Vec::with_capacity(spectrum_bins),
+                    ..Prepared::default()
+                })
+                .collect(),
             masked: Vec::with_capacity(spectrum_bins),
-            scratch: Vec::with_capacity(spectrum_bins),
+            keys: Vec::with_capacity(spectrum_bins),
             knots: Vec::with_capacity(spectrum_bins),
-            spread: 0.0,
-            bin_hz: 0.0,
-            amplitude_len: 0,
         }
     }
 
@@ -221,11 +236,8 @@ impl FaultScorer {
         fault: FaultKind,
         freqs: &FaultFrequencies,
     ) -> FaultScore {
-        if !self.prepare(amplitude, bin_hz, freqs) {
-            return FaultScore::unscored(fault, freqs);
-        }
-        self.masked.clear();
-        self.comb_score(amplitude, fault, freqs)
+        self.prepare(0, amplitude, bin_hz, freqs);
+        self.score_prepared(0, amplitude, fault, freqs)
     }
 
     /// Scores of every fault kind, in [`FaultKind::ALL`] order.
@@ -235,11 +247,8 @@ impl FaultScorer {
         bin_hz: f64,
         freqs: &FaultFrequencies,
     ) -> [FaultScore; 4] {
-        if !self.prepare(amplitude, bin_hz, freqs) {
-            return FaultKind::ALL.map(|kind| FaultScore::unscored(kind, freqs));
-        }
-        self.masked.clear();
-        FaultKind::ALL.map(|kind| self.comb_score(amplitude, kind, freqs))
+        self.prepare(0, amplitude, bin_hz, freqs);
+        FaultKind::ALL.map(|kind| self.score_prepared(0, amplitude, kind, freqs))
     }
 
     /// The score of `fault` on the evidence `winner` does not explain: the winner's comb (at its
@@ -253,95 +262,103 @@ impl FaultScorer {
         freqs: &FaultFrequencies,
         winner: &FaultScore,
     ) -> FaultScore {
-        if !self.prepare(amplitude, bin_hz, freqs) {
-            return FaultScore::unscored(fault, freqs);
-        }
-        self.mask_comb(winner, freqs);
-        let score = self.comb_score(amplitude, fault, freqs);
-        self.masked.clear();
-        score
+        self.prepare(0, amplitude, bin_hz, freqs);
+        self.score_explained_prepared(0, amplitude, fault, freqs, winner)
     }
 
-    /// Computes the excess and its spread; false when there is nothing to score.
-    fn prepare(&mut self, amplitude: &[f32], bin_hz: f64, freqs: &FaultFrequencies) -> bool {
-        self.excess.clear();
-        self.bin_hz = bin_hz;
-        self.amplitude_len = amplitude.len();
+    /// Prepares `amplitude` (bins spaced `bin_hz` from 0 Hz) into `slot` for
+    /// [`Self::score_prepared`] and [`Self::score_explained_prepared`]; false when there is
+    /// nothing to score (those then say unscored).
+    pub fn prepare(
+        &mut self,
+        slot: usize,
+        amplitude: &[f32],
+        bin_hz: f64,
+        freqs: &FaultFrequencies,
+    ) -> bool {
+        while self.slots.len() <= slot {
+            self.slots.push(Prepared {
+                excess: Vec::with_capacity(self.spectrum_bins),
+                ..Prepared::default()
+            });
+        }
+        let FaultScorer {
+            slots, keys, knots, ..
+        } = self;
+        let prepared = &mut slots[slot];
+        prepared.excess.clear();
+        prepared.bin_hz = bin_hz;
         let lowest = freqs.bpfo.min(freqs.bpfi).min(freqs.two_bsf);
         if amplitude.len() < 16 || !is_positive(bin_hz) || !is_positive(lowest) {
             return false;
         }
+        let excess = &mut prepared.excess;
         let tiny = f32::MIN_POSITIVE;
-        self.excess
-            .extend(amplitude.iter().map(|&a| a.max(tiny).ln()));
+        excess.extend(amplitude.iter().map(|&a| a.max(tiny).ln()));
         let half = ((0.3 * lowest / bin_hz).round() as usize).max(8);
-        self.subtract_running_median(half);
+        subtract_running_median(excess, half, keys, knots);
         // The first bins hold the envelope's DC leakage.
-        for e in self.excess.iter_mut().take(3) {
+        for e in excess.iter_mut().take(3) {
             *e = 0.0;
         }
         // Shaft harmonics: every rotating machine shows them; they are nobody's fault line.
         if freqs.shaft > 0.0 {
-            let n = self.excess.len();
+            let n = excess.len();
             let mut order = 1.0;
             while order * freqs.shaft / bin_hz < n as f64 - 1.0 {
                 let centre = order * freqs.shaft / bin_hz;
                 let lo = (centre - 1.5).max(0.0) as usize;
                 let hi = ((centre + 1.5) as usize).min(n - 1);
-                for e in &mut self.excess[lo..=hi] {
+                for e in &mut excess[lo..=hi] {
                     *e = e.min(0.0);
                 }
                 order += 1.0;
             }
         }
-        self.scratch.clear();
-        self.scratch.extend_from_slice(&self.excess);
-        let median = median_in_place(&mut self.scratch);
-        for x in &mut self.scratch {
-            *x = (*x - median).abs();
-        }
-        self.spread = 1.4826 * f64::from(median_in_place(&mut self.scratch));
+        let median = median_of(excess.iter().copied(), keys);
+        let mad = median_of(excess.iter().map(|&x| (x - median).abs()), keys);
+        prepared.spread = 1.4826 * f64::from(mad);
         true
     }
 
-    /// `excess -= running median of excess over ±half bins`, the median evaluated every
-    /// `half/4` bins and interpolated in between (the floor is smooth at that scale; this
-    /// keeps the cost per spectrum near `bins × 8` instead of `bins × half`).
-    fn subtract_running_median(&mut self, half: usize) {
-        let n = self.excess.len();
-        let stride = (half / 4).max(1);
-        self.knots.clear();
-        let mut centre: usize = 0;
-        loop {
-            let lo = centre.saturating_sub(half);
-            let hi = (centre + half).min(n - 1);
-            self.scratch.clear();
-            self.scratch.extend_from_slice(&self.excess[lo..=hi]);
-            let m = median_in_place(&mut self.scratch);
-            self.knots.push(m);
-            if centre >= n - 1 {
-                break;
-            }
-            centre = (centre + stride).min(n - 1);
+    /// The score of `fault` in the spectrum prepared in `slot` (`amplitude` is that spectrum,
+    /// for the peaks' amplitudes).
+    pub fn score_prepared(
+        &mut self,
+        slot: usize,
+        amplitude: &[f32],
+        fault: FaultKind,
+        freqs: &FaultFrequencies,
+    ) -> FaultScore {
+        self.masked.clear();
+        match self.slots.get(slot).filter(|p| !p.excess.is_empty()) {
+            Some(prepared) => self.comb_score(prepared, amplitude, fault, freqs),
+            None => FaultScore::unscored(fault, freqs),
         }
-        for (i, e) in self.excess.iter_mut().enumerate() {
-            let k = i / stride;
-            let floor = match (self.knots.get(k), self.knots.get(k + 1)) {
-                (Some(&a), Some(&b)) => {
-                    let x0 = k * stride;
-                    let x1 = ((k + 1) * stride).min(n - 1);
-                    let t = if x1 > x0 {
-                        (i - x0) as f32 / (x1 - x0) as f32
-                    } else {
-                        0.0
-                    };
-                    a + (b - a) * t
-                }
-                (Some(&a), None) => a,
-                _ => 0.0,
-            };
-            *e -= floor;
-        }
+    }
+
+    /// [`Self::score_explained`] on the spectrum prepared in `slot`.
+    pub fn score_explained_prepared(
+        &mut self,
+        slot: usize,
+        amplitude: &[f32],
+        fault: FaultKind,
+        freqs: &FaultFrequencies,
+        winner: &FaultScore,
+    ) -> FaultScore {
+        let Some(prepared) = self.slots.get(slot).filter(|p| !p.excess.is_empty()) else {
+            return FaultScore::unscored(fault, freqs);
+        };
+        mask_comb(
+            &mut self.masked,
+            prepared,
+            self.harmonics.min(CAGE_HARMONICS),
+            winner,
+            freqs,
+        );
+        let score = self.comb_score(prepared, amplitude, fault, freqs);
+        self.masked.clear();
+        score
     }
 
     /// How many harmonics `fault`'s comb has.
@@ -386,8 +403,8 @@ impl FaultScorer {
     }
 
     /// The largest excess within ±`half` bins of `centre` (masked bins count as the floor).
-    fn line_excess(&self, centre: f64, half: f64) -> Option<(usize, f32)> {
-        let n = self.excess.len();
+    fn line_excess(&self, prepared: &Prepared, centre: f64, half: f64) -> Option<(usize, f32)> {
+        let n = prepared.excess.len();
         if centre <= 0.0 || centre + half >= (n - 1) as f64 {
             return None;
         }
@@ -398,7 +415,7 @@ impl FaultScorer {
             let e = if self.masked.get(bin).copied().unwrap_or(false) {
                 0.0
             } else {
-                self.excess[bin]
+                prepared.excess[bin]
             };
             if e > best.1 {
                 best = (bin, e);
@@ -409,13 +426,14 @@ impl FaultScorer {
 
     fn comb_score(
         &self,
+        prepared: &Prepared,
         amplitude: &[f32],
         fault: FaultKind,
         freqs: &FaultFrequencies,
     ) -> FaultScore {
         let f = fault.frequency(freqs);
         let spacing = fault.sideband_spacing(freqs).unwrap_or(0.0);
-        let bin = self.bin_hz;
+        let bin = prepared.bin_hz;
         let mut result = FaultScore::unscored(fault, freqs);
         if !is_positive(f) {
             return result;
@@ -433,7 +451,7 @@ impl FaultScorer {
             } else {
                 self.tolerance * s as f64 / steps as f64
             };
-            let Some(effect) = self.comb_effect(lines, f, spacing, slip) else {
+            let Some(effect) = self.comb_effect(prepared, lines, f, spacing, slip) else {
                 continue;
             };
             if best.is_none_or(|(b, _)| effect > b) {
@@ -446,8 +464,8 @@ impl FaultScorer {
         result.score = effect.exp();
         result.slip = slip;
         result.frequency_hz = f * (1.0 + slip);
-        result.significance = if self.spread > 0.0 {
-            noise_significance(effect / self.spread, spacing > 0.0, harmonics)
+        result.significance = if prepared.spread > 0.0 {
+            noise_significance(effect / prepared.spread, spacing > 0.0, harmonics)
         } else {
             0.0
         };
@@ -458,7 +476,7 @@ impl FaultScorer {
             let target =
                 line.order as f64 * f * (1.0 + slip) + line.sideband * spacing * (1.0 + slip);
             let half = (LINE_HALF_WIDTH * line.order as f64 * f / bin).max(1.0);
-            let Some((peak_bin, e)) = self.line_excess(target / bin, half) else {
+            let Some((peak_bin, e)) = self.line_excess(prepared, target / bin, half) else {
                 continue;
             };
             if line.sideband != 0.0 {
@@ -483,14 +501,21 @@ impl FaultScorer {
 
     /// The comb's weighted mean positive excess at `slip`; `None` when not one harmonic fits in
     /// the spectrum.
-    fn comb_effect(&self, lines: &[CombLine], f: f64, spacing: f64, slip: f64) -> Option<f64> {
-        let bin = self.bin_hz;
+    fn comb_effect(
+        &self,
+        prepared: &Prepared,
+        lines: &[CombLine],
+        f: f64,
+        spacing: f64,
+        slip: f64,
+    ) -> Option<f64> {
+        let bin = prepared.bin_hz;
         let (mut sum, mut weights, mut harmonics) = (0.0, 0.0, 0);
         for line in lines {
             let target =
                 line.order as f64 * f * (1.0 + slip) + line.sideband * spacing * (1.0 + slip);
             let half = (LINE_HALF_WIDTH * line.order as f64 * f / bin).max(1.0);
-            let Some((_, e)) = self.line_excess(target / bin, half) else {
+            let Some((_, e)) = self.line_excess(prepared, target / bin, half) else {
                 continue;
             };
             sum += line.weight * f64::from(e.max(0.0));
@@ -501,54 +526,103 @@ impl FaultScorer {
         }
         (harmonics > 0).then(|| sum / weights)
     }
+}
 
-    /// Marks the bins `winner`'s comb explains (see [`Self::score_explained`]).
-    fn mask_comb(&mut self, winner: &FaultScore, freqs: &FaultFrequencies) {
-        let n = self.excess.len();
-        self.masked.clear();
-        self.masked.resize(n, false);
-        let f = winner.frequency_hz;
-        let bin = self.bin_hz;
-        if !is_positive(f) {
-            return;
+/// `excess -= running median of excess over ±half bins`, the median evaluated every `half/4`
+/// bins and interpolated in between (the floor is smooth at that scale; this keeps the cost
+/// per spectrum near `bins × 8` instead of `bins × half`).
+fn subtract_running_median(
+    excess: &mut [f32],
+    half: usize,
+    keys: &mut Vec<i32>,
+    knots: &mut Vec<f32>,
+) {
+    let n = excess.len();
+    let stride = (half / 4).max(1);
+    knots.clear();
+    let mut centre: usize = 0;
+    loop {
+        let lo = centre.saturating_sub(half);
+        let hi = (centre + half).min(n - 1);
+        knots.push(median_of(excess[lo..=hi].iter().copied(), keys));
+        if centre >= n - 1 {
+            break;
         }
-        let shaft = freqs.shaft * (1.0 + winner.slip);
-        let cage = freqs.ftf * (1.0 + winner.slip);
-        let mut offsets = [0.0; 9];
-        let mut count = 0;
-        for o in [0.0, -2.0, -1.0, 1.0, 2.0] {
-            offsets[count] = o * shaft;
+        centre = (centre + stride).min(n - 1);
+    }
+    for (i, e) in excess.iter_mut().enumerate() {
+        let k = i / stride;
+        let floor = match (knots.get(k), knots.get(k + 1)) {
+            (Some(&a), Some(&b)) => {
+                let x0 = k * stride;
+                let x1 = ((k + 1) * stride).min(n - 1);
+                let t = if x1 > x0 {
+                    (i - x0) as f32 / (x1 - x0) as f32
+                } else {
+                    0.0
+                };
+                a + (b - a) * t
+            }
+            (Some(&a), None) => a,
+            _ => 0.0,
+        };
+        *e -= floor;
+    }
+}
+
+/// Marks in `masked` the bins of `prepared` that `winner`'s comb explains (see
+/// [`FaultScorer::score_explained`]); a cage comb has `cage_harmonics` harmonics.
+fn mask_comb(
+    masked: &mut Vec<bool>,
+    prepared: &Prepared,
+    cage_harmonics: usize,
+    winner: &FaultScore,
+    freqs: &FaultFrequencies,
+) {
+    let n = prepared.excess.len();
+    masked.clear();
+    masked.resize(n, false);
+    let f = winner.frequency_hz;
+    let bin = prepared.bin_hz;
+    if !is_positive(f) {
+        return;
+    }
+    let shaft = freqs.shaft * (1.0 + winner.slip);
+    let cage = freqs.ftf * (1.0 + winner.slip);
+    let mut offsets = [0.0; 9];
+    let mut count = 0;
+    for o in [0.0, -2.0, -1.0, 1.0, 2.0] {
+        offsets[count] = o * shaft;
+        count += 1;
+    }
+    if winner.fault == FaultKind::Ball {
+        for o in [-2.0, -1.0, 1.0, 2.0] {
+            offsets[count] = o * cage;
             count += 1;
         }
-        if winner.fault == FaultKind::Ball {
-            for o in [-2.0, -1.0, 1.0, 2.0] {
-                offsets[count] = o * cage;
-                count += 1;
-            }
+    }
+    // A cage comb is only its first harmonics (its higher ones are other faults' lines:
+    // BPFO is a multiple of FTF).
+    let last_order = if winner.fault == FaultKind::Cage {
+        cage_harmonics as f64
+    } else {
+        f64::INFINITY
+    };
+    let mut order = 1.0;
+    while (order * f - 2.0 * shaft) / bin < n as f64 && order <= last_order {
+        for offset in &offsets[..count] {
+            mark_line(masked, order * f + offset, order * f, bin);
         }
-        // A cage comb is only its first harmonics (its higher ones are other faults' lines:
-        // BPFO is a multiple of FTF).
-        let last_order = if winner.fault == FaultKind::Cage {
-            self.comb_harmonics(FaultKind::Cage) as f64
-        } else {
-            f64::INFINITY
-        };
-        let mut order = 1.0;
-        while (order * f - 2.0 * shaft) / bin < n as f64 && order <= last_order {
-            for offset in &offsets[..count] {
-                mark_line(&mut self.masked, order * f + offset, order * f, bin);
-            }
-            order += 1.0;
-        }
-        // An outer-race fault is a ball passing a defect; balls differ, so its impacts repeat
-        // with the cage as well. A damaged ball is carried by the cage through the load zone
-        // once per cage turn, so its impacts swell and fade at FTF. Either way the cage comb
-        // is part of what the winner explains.
-        if matches!(winner.fault, FaultKind::OuterRace | FaultKind::Ball) {
-            for order in 1..=self.comb_harmonics(FaultKind::Cage) {
-                let line = order as f64 * cage;
-                mark_line(&mut self.masked, line, line, bin);
-            }
+        order += 1.0;
+    }
+    // An outer-race fault is a ball passing a defect; balls differ, so its impacts repeat
+    // with the cage as well. A damaged ball is carried by the cage through the load zone
+    // once per cage turn, so its impacts swell and fade at FTF. Either way the cage comb
+    // is part of what the winner explains.
+    if matches!(winner.fault, FaultKind::OuterRace | FaultKind::Ball) {
+        for order in 1..=cage_harmonics {
+            let line = order as f64 * cage;
+            mark_line(masked, line, line, bin);
         }
     }
 }
@@ -573,13 +647,27 @@ fn is_positive(x: f64) -> bool {
     x.is_finite() && x > 0.0
 }
 
-/// The median of `values` (reordered in place); 0 for none.
-fn median_in_place(values: &mut [f32]) -> f32 {
-    if values.is_empty() {
+/// The median of `values` (the upper one of an even count; 0 for none), selected on integer
+/// keys that order as [`f32::total_cmp`] orders the values: the same median, with one integer
+/// compare where `total_cmp` converts both operands at every comparison. `keys` is scratch.
+fn median_of(values: impl Iterator<Item = f32>, keys: &mut Vec<i32>) -> f32 {
+    keys.clear();
+    keys.extend(values.map(total_order_key));
+    if keys.is_empty() {
         return 0.0;
     }
-    let middle = values.len() / 2;
-    *values.select_nth_unstable_by(middle, f32::total_cmp).1
+    let middle = keys.len() / 2;
+    // The key transform is its own inverse.
+    f32::from_bits(
+        total_order_key(f32::from_bits(*keys.select_nth_unstable(middle).1 as u32)) as u32,
+    )
+}
+
+/// `x`'s bits as an integer that orders as [`f32::total_cmp`] orders floats (negative values
+/// have their magnitude bits flipped).
+fn total_order_key(x: f32) -> i32 {
+    let bits = x.to_bits() as i32;
+    bits ^ ((((bits >> 31) as u32) >> 1) as i32)
 }
 
 #[cfg(test)]
@@ -589,6 +677,26 @@ mod tests {
     use crate::random::Rng;
 
     const BIN_HZ: f64 = 12_000.0 / 4096.0;
+
+    #[test]
+    fn the_median_on_integer_keys_is_the_total_order_median() {
+        let mut rng = Rng::new(3);
+        let mut keys = Vec::new();
+        for len in [1usize, 2, 3, 8, 81, 1_200] {
+            let mut values: Vec<f32> = (0..len).map(|_| (rng.normal() * 30.0) as f32).collect();
+            values[0] = -0.0;
+            if len > 3 {
+                values[1] = f32::INFINITY;
+                values[2] = f32::NEG_INFINITY;
+                values[3] = 0.0;
+            }
+            let mut sorted = values.clone();
+            sorted.sort_by(f32::total_cmp);
+            let got = median_of(values.iter().copied(), &mut keys);
+            assert_eq!(got.to_bits(), sorted[len / 2].to_bits(), "len {len}");
+        }
+        assert_eq!(median_of(std::iter::empty(), &mut keys), 0.0);
+    }
 
     fn cwru() -> FaultFrequencies {
         BearingGeometry::from_catalog("skf-6205-2rs")

@@ -37,6 +37,13 @@ fn for_each_lane(parts: &[&[f32]], mut each: impl FnMut(usize, f32)) {
     }
 }
 
+/// `Σ x` over `parts` in f64, in independent partial sums.
+pub fn sum_of(parts: &[&[f32]]) -> f64 {
+    let mut sums = [0.0f64; LANES];
+    for_each_lane(parts, |lane, x| sums[lane] += f64::from(x));
+    sums.iter().sum()
+}
+
 impl Indicators {
     /// Indicators of `samples`, which may come as several slices (a ring buffer's halves).
     pub fn of_slices(parts: &[&[f32]]) -> Self {
@@ -45,9 +52,7 @@ impl Indicators {
             return Indicators::default();
         }
         let n = count as f64;
-        let mut sums = [0.0f64; LANES];
-        for_each_lane(parts, |lane, x| sums[lane] += f64::from(x));
-        let mean = sums.iter().sum::<f64>() / n;
+        let mean = sum_of(parts) / n;
         let (mut m2, mut m4, mut peaks) = ([0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES]);
         for_each_lane(parts, |lane, x| {
             let d = f64::from(x) - mean;

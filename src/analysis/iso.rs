@@ -21,6 +21,7 @@
 
 use super::envelope::{hop_samples, window_starts, FftPlans};
 use super::flags::FlagSettings;
+use super::indicators::sum_of;
 use crate::messages::IsoZone;
 use realfft::RealToComplex;
 use rustfft::num_complex::Complex32;
@@ -243,37 +244,67 @@ impl VelocityIntegrator {
         &mut self,
         older: &[f32],
         newer: &[f32],
-        mut per_bin: Option<&mut [f64]>,
+        per_bin: Option<&mut [f64]>,
     ) -> f64 {
         let n = self.input.len();
         if older.len() + newer.len() != n {
             return f64::NAN;
         }
-        let mean = (older
-            .iter()
-            .chain(newer)
-            .map(|&x| f64::from(x))
-            .sum::<f64>()
-            / n as f64) as f32;
-        for ((slot, &x), &w) in self
-            .input
-            .iter_mut()
-            .zip(older.iter().chain(newer))
-            .zip(self.hann.iter())
-        {
-            *slot = (x - mean) * w;
+        let mean = (sum_of(&[older, newer]) / n as f64) as f32;
+        // The two parts one after the other (a chained iterator would not vectorise).
+        let (input_older, input_newer) = self.input.split_at_mut(older.len());
+        let (hann_older, hann_newer) = self.hann.split_at(older.len());
+        for (input, part, hann) in [
+            (input_older, older, hann_older),
+            (input_newer, newer, hann_newer),
+        ] {
+            for ((slot, &x), &w) in input.iter_mut().zip(part).zip(hann) {
+                *slot = (x - mean) * w;
+            }
         }
         // Lengths match by construction, so the transform cannot fail.
         let _ =
             self.fft
                 .process_with_scratch(&mut self.input, &mut self.spectrum, &mut self.scratch);
+        let spectrum = &self.spectrum;
+        self.in_band(|k| spectrum[k], per_bin)
+    }
+
+    /// The same mean square from the *unwindowed* real FFT of the same window (the envelope's,
+    /// `window / 2 + 1` bins), which saves the daemon one window FFT per hop: a periodic Hann
+    /// window is, in the frequency domain, `Xw[k] = ½X[k] − ¼(X[k−1] + X[k+1])`, and the mean
+    /// reaches only bins 0 and 1, below the band ([`Self::takes_unwindowed`]).
+    pub fn mean_square_of_unwindowed(&self, spectrum: &[Complex32]) -> f64 {
+        let n = self.input.len();
+        if spectrum.len() != n / 2 + 1 {
+            return f64::NAN;
+        }
+        // Bins above n/2 mirror those below (a real signal).
+        let bin = |k: usize| {
+            if k <= n / 2 {
+                spectrum[k]
+            } else {
+                spectrum[n - k].conj()
+            }
+        };
+        self.in_band(|k| bin(k) * 0.5 - (bin(k - 1) + bin(k + 1)) * 0.25, None)
+    }
+
+    /// Whether [`Self::mean_square_of_unwindowed`] applies: the band starts above bin 1.
+    pub fn takes_unwindowed(&self) -> bool {
+        *self.bins.start() >= 2
+    }
+
+    /// `Σ` over the band's bins of bin power × the integration weight; `per_bin`, if given,
+    /// gets each bin's share added.
+    fn in_band(&self, bin: impl Fn(usize) -> Complex32, mut per_bin: Option<&mut [f64]>) -> f64 {
+        let half = self.input.len() / 2;
         let mut total = 0.0;
-        let half = n / 2;
         for k in self.bins.clone() {
             let f = k as f64 * self.bin_hz();
             // The Nyquist bin has no mirror image: counted once, not twice.
             let sides = if k == half { 1.0 } else { 2.0 };
-            let share = f64::from(self.spectrum[k].norm_sqr()) * sides * self.scale / (f * f);
+            let share = f64::from(bin(k).norm_sqr()) * sides * self.scale / (f * f);
             if let Some(out) = per_bin.as_deref_mut().and_then(|o| o.get_mut(k)) {
                 *out += share;
             }
@@ -405,6 +436,8 @@ pub struct VelocityTracker {
     phase: usize,
     /// Mean squares of the last windows, circular.
     history: Vec<f64>,
+    /// Readings come from the envelope's window spectra ([`Self::share_windows_with`]).
+    shares_windows: bool,
     history_len: usize,
     history_pos: usize,
 }
@@ -437,6 +470,7 @@ impl VelocityTracker {
             to_next_hop: window,
             phase: 0,
             history: vec![0.0; averages.max(1)],
+            shares_windows: false,
             history_len: 0,
             history_pos: 0,
         }
@@ -446,12 +480,12 @@ impl VelocityTracker {
     /// [`RollingEnvelope::with_phase`](crate::analysis::envelope::RollingEnvelope::with_phase).
     pub fn with_phase(mut self, phase: usize) -> Self {
         self.phase = phase.min(self.hop.saturating_sub(1));
-        self.to_next_hop = self.ring.len() + self.phase;
+        self.to_next_hop = self.integrator.window() + self.phase;
         self
     }
 
     pub fn window(&self) -> usize {
-        self.ring.len()
+        self.integrator.window()
     }
 
     pub fn hop(&self) -> usize {
@@ -471,7 +505,7 @@ impl VelocityTracker {
     /// restart): the next reading comes one whole window later, from new windows only.
     pub fn restart_at(&mut self, first_sample: u64) {
         self.samples = first_sample;
-        self.to_next_hop = self.ring.len() + self.phase;
+        self.to_next_hop = self.integrator.window() + self.phase;
         self.ring_pos = 0;
         self.history_len = 0;
         self.history_pos = 0;
@@ -479,7 +513,12 @@ impl VelocityTracker {
 
     /// Feeds a block of acceleration samples (g); hands every reading whose hop ends inside
     /// the block to `on_reading`, in order.
+    /// Does nothing when the tracker shares the envelope's windows (its readings come from
+    /// [`Self::reading_of_unwindowed`]).
     pub fn push(&mut self, block: &[f32], mut on_reading: impl FnMut(VelocityReading)) {
+        if self.shares_windows {
+            return;
+        }
         let mut rest = block;
         while !rest.is_empty() {
             let take = rest.len().min(self.to_next_hop);
@@ -505,9 +544,44 @@ impl VelocityTracker {
         }
     }
 
+    /// Makes the tracker take its windows' spectra from the envelope's windows (the real FFT
+    /// of the same raw samples) when those are its own windows: the same `window` and `hop`
+    /// (and so the same phase, which both take from the hop). Then
+    /// [`Self::reading_of_unwindowed`] replaces [`Self::push`] and the tracker keeps no samples.
+    pub fn share_windows_with(mut self, window: usize, hop: usize) -> Self {
+        if window == self.ring.len() && hop == self.hop && self.integrator.takes_unwindowed() {
+            self.shares_windows = true;
+            self.ring = Vec::new();
+        }
+        self
+    }
+
+    /// Whether readings come from [`Self::reading_of_unwindowed`] (see
+    /// [`Self::share_windows_with`]).
+    pub fn shares_windows(&self) -> bool {
+        self.shares_windows
+    }
+
+    /// The reading of the window ending at `end_sample`, from that window's unwindowed real
+    /// FFT (the envelope's).
+    pub fn reading_of_unwindowed(
+        &mut self,
+        spectrum: &[Complex32],
+        end_sample: u64,
+    ) -> VelocityReading {
+        self.samples = end_sample;
+        let ms = self.integrator.mean_square_of_unwindowed(spectrum);
+        self.record(ms)
+    }
+
     fn update(&mut self) -> VelocityReading {
         let (newer, older) = self.ring.split_at(self.ring_pos);
         let ms = self.integrator.mean_square(older, newer, None);
+        self.record(ms)
+    }
+
+    /// Takes the newest window's mean square into the average.
+    fn record(&mut self, ms: f64) -> VelocityReading {
         self.history[self.history_pos] = ms;
         self.history_pos = (self.history_pos + 1) % self.history.len();
         self.history_len = (self.history_len + 1).min(self.history.len());
@@ -696,5 +770,53 @@ mod tests {
             .collect();
         assert_eq!(changes.len(), 1, "{changes:?}");
         assert_eq!(changes[0].to, crate::messages::FlagLevel::Watch);
+    }
+
+    #[test]
+    fn a_tracker_sharing_the_envelopes_windows_reads_what_its_own_fft_reads() {
+        use crate::analysis::envelope::RollingEnvelope;
+        let fs = 25_600.0;
+        let mut plans = FftPlans::default();
+        let own = VelocityTracker::new(fs, 1772.0, SeveritySettings::default(), 4, &mut plans);
+        let (window, hop) = (own.window(), own.hop());
+        let mut own = own.with_phase(300);
+        let mut shared =
+            VelocityTracker::new(fs, 1772.0, SeveritySettings::default(), 4, &mut plans)
+                .with_phase(300)
+                .share_windows_with(window, hop);
+        assert!(shared.shares_windows());
+        let mut rolling = RollingEnvelope::new(fs, window, hop, 1, &[], 16).with_phase(300);
+        // A 1 g offset (gravity), two tones and a little noise: the offset must not leak in.
+        let mut rng = crate::random::Rng::new(7);
+        let signal: Vec<f32> = (0..(fs * 6.0) as usize)
+            .map(|n| {
+                let t = n as f64 / fs;
+                (1.0 + 0.3 * (std::f64::consts::TAU * 29.5 * t).sin()
+                    + 0.05 * (std::f64::consts::TAU * 480.0 * t).sin()
+                    + 0.01 * rng.normal()) as f32
+            })
+            .collect();
+        let (mut mine, mut theirs) = (Vec::new(), Vec::new());
+        for block in signal.chunks(2_560) {
+            own.push(block, |r| mine.push(r));
+            shared.push(block, |_| {
+                panic!("a sharing tracker reads from the envelope only")
+            });
+            rolling.push(block, |update| {
+                theirs.push(shared.reading_of_unwindowed(update.window_spectrum, update.end_sample))
+            });
+        }
+        assert_eq!(mine.len(), theirs.len());
+        assert!(mine.len() >= 8, "{} readings", mine.len());
+        for (a, b) in mine.iter().zip(&theirs) {
+            assert_eq!(a.end_sample, b.end_sample);
+            let relative = (a.rms_mm_s - b.rms_mm_s).abs() / a.rms_mm_s;
+            assert!(relative < 1e-4, "{a:?} vs {b:?}");
+            assert_eq!(a.zone, b.zone);
+        }
+        // Different windows: no sharing.
+        let other = VelocityTracker::new(fs, 1772.0, SeveritySettings::default(), 4, &mut plans)
+            .share_windows_with(window / 2, hop / 2);
+        assert!(!other.shares_windows());
     }
 }

@@ -318,7 +318,7 @@ impl ChannelMonitor {
                 &mut crate::analysis::envelope::FftPlans::shared(),
             );
             let phase = share_of(tracker.hop(), settings.window_stagger);
-            let tracker = tracker.with_phase(phase);
+            let tracker = tracker.with_phase(phase).share_windows_with(window, hop);
             let flag = FaultFlag::new(tracker.limits().flag_settings(&settings.flags));
             (tracker, flag)
         });
@@ -595,28 +595,18 @@ impl ChannelMonitor {
         self.history_filled = (self.history_filled + samples.len()).min(n);
         self.next_sample += samples.len() as u64;
 
+        // A tracker that shares the envelope's windows reads in the envelope's update below.
         if let Some((tracker, flag)) = &mut self.velocity {
-            let band_hz = tracker.band();
-            let limits = tracker.limits();
+            let (band_hz, limits) = (tracker.band(), tracker.limits());
             tracker.push(samples, |reading| {
-                if let Some(change) = flag.update(reading.rms_mm_s, reading.end_sample) {
-                    on_event(MonitorEvent::VelocityFlag {
-                        change,
-                        reading,
-                        limits,
-                    });
-                }
-                on_event(MonitorEvent::Velocity {
-                    reading,
-                    band_hz,
-                    flag: flag.level(),
-                });
+                velocity_events(reading, band_hz, limits, flag, on_event);
             });
         }
 
         let rule = self.settings.analysis.decision_rule();
         let ChannelMonitor {
             rolling,
+            velocity,
             scorer,
             flags,
             health,
@@ -631,30 +621,25 @@ impl ChannelMonitor {
         } = self;
         let speed_known = *speed_known;
         rolling.push(samples, |update| {
-            let indicators =
-                Indicators::of_slices(&[update.window_samples.0, update.window_samples.1]);
             // Before the first band selection there are no band engines: nothing to score; nor
-            // without a speed to score against.
+            // without a speed to score against. Each band's spectrum is prepared once, in the
+            // scorer slot of its engine (at most the fault's index; faults whose best band is
+            // the same share it), then scored for its faults and, below, on what the leader
+            // does not explain.
+            let slot = |i: usize| update.band_of.get(i).copied().unwrap_or(i);
+            let mut prepared = [false; FaultKind::ALL.len()];
             for (i, kind) in FaultKind::ALL.iter().enumerate() {
                 let spectrum = update
-                    .bands
-                    .get(i)
+                    .band(i)
                     .filter(|_| speed_known)
                     .map_or(&[][..], |b| b.averaged_amplitude());
-                scores[i] = scorer.score(spectrum, update.bin_hz, *kind, freqs);
+                if !std::mem::replace(&mut prepared[slot(i)], true) {
+                    scorer.prepare(slot(i), spectrum, update.bin_hz, freqs);
+                }
+                scores[i] = scorer.score_prepared(slot(i), spectrum, *kind, freqs);
             }
-            if let Some(change) =
-                health.update(indicators.kurtosis, indicators.rms, update.end_sample)
-            {
-                on_event(MonitorEvent::Stage(change));
-            }
-            let stage = health.stage();
-            let threshold = health
-                .failure_limit()
-                .filter(|_| stage >= HealthStage::Degrading);
-            if let Some(point) = trend.push(indicators.rms, update.end_sample, threshold) {
-                on_event(MonitorEvent::Trend { point, stage });
-            }
+            // The flags first, so that their alerts leave before the window's indicators,
+            // health stage and trend are computed.
             if *bands_known && speed_known {
                 // Only the leading fault feeds its flag (the verdict's rule); the others see 0
                 // and fall.
@@ -665,17 +650,9 @@ impl ChannelMonitor {
                     explained[i] = if i == leader {
                         FaultScore::unscored(*kind, freqs)
                     } else {
-                        let spectrum = update
-                            .bands
-                            .get(i)
-                            .map_or(&[][..], |b| b.averaged_amplitude());
-                        scorer.score_explained(
-                            spectrum,
-                            update.bin_hz,
-                            *kind,
-                            freqs,
-                            &scores[leader],
-                        )
+                        let spectrum = update.band(i).map_or(&[][..], |b| b.averaged_amplitude());
+                        let winner = &scores[leader];
+                        scorer.score_explained_prepared(slot(i), spectrum, *kind, freqs, winner)
                     };
                 }
                 let lead =
@@ -699,6 +676,26 @@ impl ChannelMonitor {
                     }
                 }
             }
+            if let Some((tracker, flag)) = velocity.as_mut().filter(|(t, _)| t.shares_windows()) {
+                let reading =
+                    tracker.reading_of_unwindowed(update.window_spectrum, update.end_sample);
+                let (band_hz, limits) = (tracker.band(), tracker.limits());
+                velocity_events(reading, band_hz, limits, flag, on_event);
+            }
+            let indicators =
+                Indicators::of_slices(&[update.window_samples.0, update.window_samples.1]);
+            if let Some(change) =
+                health.update(indicators.kurtosis, indicators.rms, update.end_sample)
+            {
+                on_event(MonitorEvent::Stage(change));
+            }
+            let stage = health.stage();
+            let threshold = health
+                .failure_limit()
+                .filter(|_| stage >= HealthStage::Degrading);
+            if let Some(point) = trend.push(indicators.rms, update.end_sample, threshold) {
+                on_event(MonitorEvent::Trend { point, stage });
+            }
             let top = (0..4)
                 .max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))
                 .unwrap_or(0);
@@ -707,11 +704,8 @@ impl ChannelMonitor {
                 indicators,
                 scores,
                 bands,
-                spectrum: update
-                    .bands
-                    .get(top)
-                    .map_or(&[][..], |b| b.averaged_amplitude()),
-                spectrum_band: update.bands.get(top).map_or(bands[top], |b| b.band()),
+                spectrum: update.band(top).map_or(&[][..], |b| b.averaged_amplitude()),
+                spectrum_band: update.band(top).map_or(bands[top], |b| b.band()),
                 bin_hz: update.bin_hz,
                 windows_averaged: update.windows_averaged,
             }));
@@ -828,4 +822,26 @@ impl ChannelMonitor {
             }
         }
     }
+}
+
+/// The events of one velocity reading: its zone flag's change, if any, then the reading.
+fn velocity_events(
+    reading: VelocityReading,
+    band_hz: (f64, f64),
+    limits: ZoneLimits,
+    flag: &mut FaultFlag,
+    on_event: &mut impl FnMut(MonitorEvent),
+) {
+    if let Some(change) = flag.update(reading.rms_mm_s, reading.end_sample) {
+        on_event(MonitorEvent::VelocityFlag {
+            change,
+            reading,
+            limits,
+        });
+    }
+    on_event(MonitorEvent::Velocity {
+        reading,
+        band_hz,
+        flag: flag.level(),
+    });
 }

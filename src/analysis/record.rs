@@ -216,20 +216,21 @@ pub fn analyze_with_plans(
             FaultScorer::new(settings.fault_tolerance, settings.harmonics, spectrum_bins);
         let candidates = candidate_bands(&scan, selected_band_index, settings, freqs);
         let penalty = (candidates.len().max(1) as f64).log10();
+        // Each candidate band's spectrum is prepared once (slot = its place among the
+        // candidates), then scored for every fault and on what the leader does not explain.
+        for (slot, &i) in candidates.iter().enumerate() {
+            let spectrum = &scan.bands[i].spectrum;
+            scorer.prepare(slot, &spectrum.amplitude, spectrum.bin_hz, freqs);
+        }
         let best_band = |scorer: &mut FaultScorer, kind: FaultKind, winner: Option<&FaultScore>| {
             candidates
                 .iter()
-                .map(|&i| {
-                    let spectrum = &scan.bands[i].spectrum;
+                .enumerate()
+                .map(|(slot, &i)| {
+                    let amplitude = &scan.bands[i].spectrum.amplitude;
                     let mut score = match winner {
-                        None => scorer.score(&spectrum.amplitude, spectrum.bin_hz, kind, freqs),
-                        Some(w) => scorer.score_explained(
-                            &spectrum.amplitude,
-                            spectrum.bin_hz,
-                            kind,
-                            freqs,
-                            w,
-                        ),
+                        None => scorer.score_prepared(slot, amplitude, kind, freqs),
+                        Some(w) => scorer.score_explained_prepared(slot, amplitude, kind, freqs, w),
                     };
                     score.significance = (score.significance - penalty).max(0.0);
                     Hypothesis {

@@ -1,0 +1,116 @@
+//! The analysis thread's share of alert latency (issue 12 item 4), in process, without the
+//! daemon's threads, queues or iceoryx2: for each 0.1 s block of `BENCH_SENSORS` simulated
+//! sensors, the time `Pipeline::handle` takes, and for a block that decides an alert, the time
+//! from the start of `handle` to the moment the flag change comes out (when the daemon hands
+//! it to the alert publisher).
+//!
+//! The config is the alert-latency bench's chattering one (every sensor's outer race faulty,
+//! one window per average, thresholds at the middle of the scores), so that many windows
+//! decide an alert. The inputs are seeded: two builds on one machine compare fairly.
+//!
+//! Run: `cargo bench --bench block_cost` (`BENCH_SENSORS`, default 16; `BENCH_SECONDS` of
+//! signal, default 60).
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use bearingd::config::{parse, Transport};
+use bearingd::messages::PipelineMessage;
+use bearingd::pipeline::{Output, Pipeline};
+use bearingd::sources::sim::SimSource;
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::time::Instant;
+
+fn env_or(name: &str, default: usize) -> usize {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+fn config_text(sensors: usize) -> String {
+    let mut text = String::from(
+        "[analysis]\naverages = 1\n\n[thresholds]\nwatch_score = 60.0\nalarm_score = 90.0\n\
+         clear_ratio = 0.999\non_delay_s = 0\noff_delay_s = 0\n",
+    );
+    for j in 0..sensors {
+        let _ = write!(
+            text,
+            "\n[[sensors]]\nid = \"s{j:02}\"\ntransport = \"sim\"\nsample_rate_hz = 25600\n\
+             bearing = \"skf-6205-2rs\"\n[sensors.speed]\nsource = \"fixed\"\nrpm = 1772\n\
+             [sensors.sim]\nfault = \"outer\"\nonset_s = 0.0\nseverity = 1.5\nseed = {}\n",
+            j + 1
+        );
+    }
+    text
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let rank = ((p / 100.0) * sorted.len() as f64).ceil() as usize;
+    sorted[rank.clamp(1, sorted.len()) - 1]
+}
+
+fn report(what: &str, mut values_us: Vec<f64>) {
+    values_us.sort_by(f64::total_cmp);
+    println!(
+        "{what:<44} {:>6} blocks  p50 {:>7.1} µs  p90 {:>7.1}  p99 {:>7.1}  max {:>7.1}",
+        values_us.len(),
+        percentile(&values_us, 50.0),
+        percentile(&values_us, 90.0),
+        percentile(&values_us, 99.0),
+        values_us.last().copied().unwrap_or(f64::NAN),
+    );
+}
+
+fn main() {
+    if std::env::args().any(|a| a == "--list") {
+        return;
+    }
+    let sensors = env_or("BENCH_SENSORS", 16);
+    let seconds = env_or("BENCH_SECONDS", 60);
+    let config = parse(&config_text(sensors), "block_cost bench").expect("bench config");
+    let mut sources: Vec<SimSource> = config
+        .sensors
+        .iter()
+        .filter_map(|s| match &s.transport {
+            Transport::Sim(sim) => Some(SimSource::new(s, sim, 0.1)),
+            _ => None,
+        })
+        .collect();
+    let mut pipeline = Pipeline::new(&config, &BTreeMap::new());
+    let (mut quiet, mut window, mut to_flag, mut deciding) = (vec![], vec![], vec![], vec![]);
+    for _ in 0..seconds * 10 {
+        for source in &mut sources {
+            for input in source.next_blocks() {
+                let started = Instant::now();
+                let mut first_flag_us = None;
+                let mut windows = 0;
+                pipeline.handle(input, &mut |output| match output {
+                    Output::Message(PipelineMessage::Flag(_)) => {
+                        first_flag_us.get_or_insert_with(|| started.elapsed().as_secs_f64() * 1e6);
+                    }
+                    Output::Message(PipelineMessage::Indicators(_)) => windows += 1,
+                    _ => {}
+                });
+                let took_us = started.elapsed().as_secs_f64() * 1e6;
+                match (windows, first_flag_us) {
+                    (0, _) => quiet.push(took_us),
+                    (_, None) => window.push(took_us),
+                    (_, Some(flag_us)) => {
+                        to_flag.push(flag_us);
+                        deciding.push(took_us);
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "Pipeline::handle, {sensors} sensors × 25.6 kHz, {seconds} s of signal in 0.1 s blocks:"
+    );
+    report("block closing no window", quiet);
+    report("block closing a window, no alert", window);
+    report("block deciding an alert: whole block", deciding);
+    report("block deciding an alert: until the flag", to_flag);
+}
