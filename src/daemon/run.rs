@@ -28,6 +28,10 @@
 //! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
 //!   them at shutdown happens there.
 //!
+//! Every thread but the analysis thread runs at a lower CPU priority
+//! ([`crate::pipeline::priority`]), so that the daemon's own background work never preempts
+//! the thread that decides alerts.
+//!
 //! Stopping: the sources end (a signal, `--duration`, or all of them finished); their sender
 //! closing ends the analysis thread, which closes the re-fit queue, takes the last fits and
 //! closes the sink queue, which ends the sink thread.
@@ -527,6 +531,7 @@ fn sink_thread(
     mut sinks: Vec<Box<dyn Sink>>,
     messages: &mpsc::Receiver<PipelineMessage>,
 ) -> Result<(Vec<FlagMessage>, u64), SinkError> {
+    crate::pipeline::priority::lower_this_thread();
     let mut flags = Vec::new();
     let mut count = 0u64;
     while let Ok(message) = messages.recv() {

@@ -1,12 +1,18 @@
-//! The twin's re-fit thread gives the CPU to the analysis thread. On a two-core edge box a
-//! re-fit (the twin's three hypotheses, the HW model, the learned opinion: tens of ms) sharing a
-//! core with the analysis thread delays the window that raises an alert; at a lower priority
-//! the scheduler lets the analysis thread preempt it. The re-fit still gets every idle cycle
-//! and nothing waits for it (a newer request replaces an older one), so nothing is lost.
+//! Every thread of `bearingd run` but the analysis thread runs at a lower CPU priority, so
+//! that the analysis thread (which decides and publishes alerts) is never preempted by the
+//! daemon's own background work. On a two-core edge box a trace of the daemon showed the
+//! slowest 1 % of alert-deciding blocks off the CPU for 1.3 ms, preempted by a sibling thread
+//! (the simulated sensors' generation on the async runtime, the log writer, a band selection,
+//! a re-fit); with these threads lowered the analysis ran uninterrupted (docs/PERFORMANCE.md,
+//! issue 12).
 //!
-//! Only the re-fit thread: the band worker and the log writer stay at normal priority, because
-//! the analysis *does* wait for them (a band selection's result at its due sample, a full log
-//! queue); starved under load they made the tail worse (docs/PERFORMANCE.md, issue 12).
+//! Lowered: the async runtime's workers (sources, status), the log writer, the band worker,
+//! the twin's re-fit thread and the alert keeper. Each still gets every cycle the analysis
+//! leaves idle (it uses about a tenth of one core for 16 channels at 25.6 kHz); the analysis
+//! waits for the band worker and the log writer only when they fall seconds behind (a band
+//! result at its due sample, a full log queue of 1,024 messages), which lowering did not cause
+//! in the measurements. The priority is relative to this process's other threads only as far
+//! as the scheduler goes; other programs on the box are unaffected.
 
 /// (choice) Nice +10: about a tenth of the CPU share of a normal thread when both want it.
 const BACKGROUND_NICE: libc::c_int = 10;
