@@ -23,53 +23,31 @@
 //! comparison on the same machine load).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
 use bearingd::clock::wall_clock_now_ns;
 use bearingd::iox::IoxSettings;
 use bearingd::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
+use common::{env_or, percentile, simulated_sensors, CHATTERING_THRESHOLDS};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
-
-fn env_or(name: &str, default: usize) -> usize {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
 
 /// `sensors` simulated sensors; sensor j's outer race fails at 2 + 2.5 j s, or at 0 with
 /// `chatter` (then the flags chatter: see the module doc).
 fn write_config(dir: &Path, iox: &Path, sensors: usize, rate: usize, chatter: bool) -> PathBuf {
     let mut text = String::new();
     if chatter {
-        text.push_str(
-            "[analysis]\naverages = 1\n\n[thresholds]\nwatch_score = 60.0\nalarm_score = 90.0\n\
-             clear_ratio = 0.999\non_delay_s = 0\noff_delay_s = 0\n",
-        );
+        text.push_str(CHATTERING_THRESHOLDS);
     }
-    for j in 0..sensors {
-        let _ = write!(
-            text,
-            r#"
-[[sensors]]
-id = "s{j:02}"
-transport = "sim"
-sample_rate_hz = {rate}
-bearing = "skf-6205-2rs"
-[sensors.speed]
-source = "fixed"
-rpm = 1772
-[sensors.sim]
-fault = "outer"
-onset_s = {onset}
-severity = 1.5
-seed = {seed}
-"#,
-            onset = if chatter { 0.0 } else { 2.0 + 2.5 * j as f64 },
-            seed = j + 1
-        );
-    }
+    text += &simulated_sensors(sensors, rate, |j| {
+        if chatter {
+            0.0
+        } else {
+            2.0 + 2.5 * j as f64
+        }
+    });
     let _ = write!(
         text,
         r#"
@@ -85,11 +63,6 @@ iceoryx2_root = "{iox}"
     let path = dir.join("bench.toml");
     std::fs::write(&path, text).expect("write the bench config");
     path
-}
-
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    let rank = ((p / 100.0) * sorted.len() as f64).ceil() as usize;
-    sorted[rank.clamp(1, sorted.len()) - 1]
 }
 
 fn main() {

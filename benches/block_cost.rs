@@ -12,44 +12,18 @@
 //! signal, default 60).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
+mod common;
+
 use bearingd::config::{parse, Transport};
 use bearingd::messages::PipelineMessage;
 use bearingd::pipeline::{Output, Pipeline};
 use bearingd::sources::sim::SimSource;
+use common::{env_or, percentile, simulated_sensors, CHATTERING_THRESHOLDS};
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 use std::time::Instant;
 
-fn env_or(name: &str, default: usize) -> usize {
-    std::env::var(name)
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(default)
-}
-
 fn config_text(sensors: usize) -> String {
-    let mut text = String::from(
-        "[analysis]\naverages = 1\n\n[thresholds]\nwatch_score = 60.0\nalarm_score = 90.0\n\
-         clear_ratio = 0.999\non_delay_s = 0\noff_delay_s = 0\n",
-    );
-    for j in 0..sensors {
-        let _ = write!(
-            text,
-            "\n[[sensors]]\nid = \"s{j:02}\"\ntransport = \"sim\"\nsample_rate_hz = 25600\n\
-             bearing = \"skf-6205-2rs\"\n[sensors.speed]\nsource = \"fixed\"\nrpm = 1772\n\
-             [sensors.sim]\nfault = \"outer\"\nonset_s = 0.0\nseverity = 1.5\nseed = {}\n",
-            j + 1
-        );
-    }
-    text
-}
-
-fn percentile(sorted: &[f64], p: f64) -> f64 {
-    if sorted.is_empty() {
-        return f64::NAN;
-    }
-    let rank = ((p / 100.0) * sorted.len() as f64).ceil() as usize;
-    sorted[rank.clamp(1, sorted.len()) - 1]
+    CHATTERING_THRESHOLDS.to_string() + &simulated_sensors(sensors, 25_600, |_| 0.0)
 }
 
 fn report(what: &str, mut values_us: Vec<f64>) {

@@ -1,0 +1,46 @@
+//! What the latency benches share (`alert_latency`, `block_cost`): reading their knobs from the
+//! environment, percentiles, and the simulated-sensor config whose flags chatter, so that both
+//! measure the same analysis on the same inputs.
+#![allow(dead_code)] // each bench uses its own subset
+
+use std::fmt::Write as _;
+
+/// The environment variable `name` as a number, or `default` when unset or not a number.
+pub fn env_or(name: &str, default: usize) -> usize {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
+/// The nearest-rank percentile `p` (0–100) of ascending `sorted`; NaN when empty.
+pub fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let rank = ((p / 100.0) * sorted.len() as f64).ceil() as usize;
+    sorted[rank.clamp(1, sorted.len()) - 1]
+}
+
+/// Config that makes the flags chatter: one window per average, thresholds at the middle of the
+/// outer-race scores, no delays and almost no hysteresis, so that about 40 % of the windows of
+/// a faulty sensor raise or clear an alert. Everything else is the default config's.
+pub const CHATTERING_THRESHOLDS: &str = "[analysis]\naverages = 1\n\n[thresholds]\n\
+     watch_score = 60.0\nalarm_score = 90.0\nclear_ratio = 0.999\non_delay_s = 0\noff_delay_s = 0\n";
+
+/// `sensors` simulated SKF 6205 sensors at `rate_hz` and 1772 rpm with seeds 1, 2, …; sensor
+/// j's outer race fails at `onset_s(j)`.
+pub fn simulated_sensors(sensors: usize, rate_hz: usize, onset_s: impl Fn(usize) -> f64) -> String {
+    let mut text = String::new();
+    for j in 0..sensors {
+        let _ = write!(
+            text,
+            "\n[[sensors]]\nid = \"s{j:02}\"\ntransport = \"sim\"\nsample_rate_hz = {rate_hz}\n\
+             bearing = \"skf-6205-2rs\"\n[sensors.speed]\nsource = \"fixed\"\nrpm = 1772\n\
+             [sensors.sim]\nfault = \"outer\"\nonset_s = {onset:?}\nseverity = 1.5\nseed = {seed}\n",
+            onset = onset_s(j),
+            seed = j + 1
+        );
+    }
+    text
+}
