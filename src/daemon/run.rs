@@ -9,9 +9,10 @@
 //!   ([`ANALYSIS_QUEUE`]) and wait when it is full (`Block`): an in-process source is simply
 //!   slowed; a transport source then backs up into its own buffer, where a loss shows as an
 //!   exact sequence gap.
-//! - analysis thread ([`AnalysisThread`]): owns the [`Pipeline`] and the alert sink; hands
-//!   messages to the sink queue (`Block`), publishes the alerts of flag changes itself
-//!   (iceoryx2's send does not block), and hands twin requests to the re-fit
+//! - analysis thread ([`AnalysisThread`]): owns the [`Pipeline`] and the alert sink;
+//!   publishes the alerts of flag changes itself (iceoryx2's send does not block), hands each
+//!   input's messages to the sink queue (`Block`) once its alerts are out, and hands twin
+//!   requests to the re-fit
 //!   hand-over ([`crate::pipeline::twin_queue`]: one slot per channel, served in turn; a request
 //!   still waiting when its channel asks again is dropped, counted and reported). Band
 //!   selections run on the pipeline's own worker thread ([`crate::pipeline::bands`]). Each input carries the wall-clock time its
@@ -175,6 +176,7 @@ pub async fn run(
         alerts,
         inputs: input_rx,
         sinks: sink_tx,
+        for_sinks: Vec::new(),
         twin_requests: Some(request_tx),
         fits: fit_rx,
         status: status_tx,
@@ -391,6 +393,9 @@ struct AnalysisThread {
     alerts: Option<AlertSink>,
     inputs: async_mpsc::Receiver<Arrived>,
     sinks: mpsc::SyncSender<PipelineMessage>,
+    /// The current input's messages, handed to the sink queue once its alerts are out (a
+    /// send wakes the sink thread: not before an alert). A few per input; reused.
+    for_sinks: Vec<PipelineMessage>,
     /// `None` once the inputs have ended (closing the re-fit queue).
     twin_requests: Option<TwinRequests>,
     fits: mpsc::Receiver<PipelineMessage>,
@@ -427,12 +432,13 @@ impl AnalysisThread {
         }
     }
 
-    /// One input through the pipeline; its outputs to the sinks, the alerts and the re-fit.
+    /// One input through the pipeline; its outputs to the alerts and the re-fit as they come,
+    /// then, in their order, to the sinks.
     fn analyse(&mut self, arrived: Arrived) {
         let AnalysisThread {
             pipeline,
             alerts,
-            sinks,
+            for_sinks,
             twin_requests,
             requests_skipped,
             events,
@@ -448,7 +454,7 @@ impl AnalysisThread {
                         let _ = (failed, &events);
                     });
                 }
-                let _ = sinks.send(message);
+                for_sinks.push(message);
             }
             Output::Twin(request) => {
                 let (channel, end_sample) = (request.channel.clone(), request.end_sample);
@@ -466,6 +472,9 @@ impl AnalysisThread {
                 }
             }
         });
+        for message in self.for_sinks.drain(..) {
+            let _ = self.sinks.send(message);
+        }
     }
 
     /// A message of the re-fit thread: a twin's fit into the channel's status and the alerts;
