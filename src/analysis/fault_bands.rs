@@ -194,6 +194,8 @@ pub struct FaultScorer {
     slots: Vec<Prepared>,
     /// Bins the winner's comb explains, when scoring explained.
     masked: Vec<bool>,
+    /// The prepared excess with those bins at the floor (0), when scoring explained.
+    unexplained: Vec<f32>,
     /// Scratch for the medians.
     keys: Vec<i32>,
     knots: Vec<f32>,
@@ -223,6 +225,7 @@ impl FaultScorer {
                 })
                 .collect(),
             masked: Vec::with_capacity(spectrum_bins),
+            unexplained: Vec::with_capacity(spectrum_bins),
             keys: Vec::with_capacity(spectrum_bins),
             knots: Vec::with_capacity(spectrum_bins),
         }
@@ -330,9 +333,8 @@ impl FaultScorer {
         fault: FaultKind,
         freqs: &FaultFrequencies,
     ) -> FaultScore {
-        self.masked.clear();
         match self.slots.get(slot).filter(|p| !p.excess.is_empty()) {
-            Some(prepared) => self.comb_score(prepared, amplitude, fault, freqs),
+            Some(prepared) => self.comb_score(prepared, &prepared.excess, amplitude, fault, freqs),
             None => FaultScore::unscored(fault, freqs),
         }
     }
@@ -356,9 +358,15 @@ impl FaultScorer {
             winner,
             freqs,
         );
-        let score = self.comb_score(prepared, amplitude, fault, freqs);
-        self.masked.clear();
-        score
+        self.unexplained.clear();
+        self.unexplained.extend(
+            prepared
+                .excess
+                .iter()
+                .zip(&self.masked)
+                .map(|(&e, &masked)| if masked { 0.0 } else { e }),
+        );
+        self.comb_score(prepared, &self.unexplained, amplitude, fault, freqs)
     }
 
     /// How many harmonics `fault`'s comb has.
@@ -402,31 +410,11 @@ impl FaultScorer {
         (lines, count)
     }
 
-    /// The largest excess within ±`half` bins of `centre` (masked bins count as the floor).
-    fn line_excess(&self, prepared: &Prepared, centre: f64, half: f64) -> Option<(usize, f32)> {
-        let n = prepared.excess.len();
-        if centre <= 0.0 || centre + half >= (n - 1) as f64 {
-            return None;
-        }
-        let lo = (centre - half).round().max(1.0) as usize;
-        let hi = ((centre + half).round() as usize).clamp(lo, n - 1);
-        let mut best = (lo, f32::MIN);
-        for bin in lo..=hi {
-            let e = if self.masked.get(bin).copied().unwrap_or(false) {
-                0.0
-            } else {
-                prepared.excess[bin]
-            };
-            if e > best.1 {
-                best = (bin, e);
-            }
-        }
-        Some(best)
-    }
-
+    /// The score of `fault` on `excess`: the prepared spectrum's, or what a winner leaves of it.
     fn comb_score(
         &self,
         prepared: &Prepared,
+        excess: &[f32],
         amplitude: &[f32],
         fault: FaultKind,
         freqs: &FaultFrequencies,
@@ -451,7 +439,7 @@ impl FaultScorer {
             } else {
                 self.tolerance * s as f64 / steps as f64
             };
-            let Some(effect) = self.comb_effect(prepared, lines, f, spacing, slip) else {
+            let Some(effect) = comb_effect(excess, bin, lines, f, spacing, slip) else {
                 continue;
             };
             if best.is_none_or(|(b, _)| effect > b) {
@@ -476,7 +464,7 @@ impl FaultScorer {
             let target =
                 line.order as f64 * f * (1.0 + slip) + line.sideband * spacing * (1.0 + slip);
             let half = (LINE_HALF_WIDTH * line.order as f64 * f / bin).max(1.0);
-            let Some((peak_bin, e)) = self.line_excess(prepared, target / bin, half) else {
+            let Some((peak_bin, e)) = line_excess(excess, target / bin, half) else {
                 continue;
             };
             if line.sideband != 0.0 {
@@ -498,34 +486,50 @@ impl FaultScorer {
         }
         result
     }
+}
 
-    /// The comb's weighted mean positive excess at `slip`; `None` when not one harmonic fits in
-    /// the spectrum.
-    fn comb_effect(
-        &self,
-        prepared: &Prepared,
-        lines: &[CombLine],
-        f: f64,
-        spacing: f64,
-        slip: f64,
-    ) -> Option<f64> {
-        let bin = prepared.bin_hz;
-        let (mut sum, mut weights, mut harmonics) = (0.0, 0.0, 0);
-        for line in lines {
-            let target =
-                line.order as f64 * f * (1.0 + slip) + line.sideband * spacing * (1.0 + slip);
-            let half = (LINE_HALF_WIDTH * line.order as f64 * f / bin).max(1.0);
-            let Some((_, e)) = self.line_excess(prepared, target / bin, half) else {
-                continue;
-            };
-            sum += line.weight * f64::from(e.max(0.0));
-            weights += line.weight;
-            if line.sideband == 0.0 {
-                harmonics += 1;
-            }
+/// The comb's weighted mean positive excess at `slip` in `excess` (bins spaced `bin_hz`);
+/// `None` when not one harmonic fits in the spectrum.
+fn comb_effect(
+    excess: &[f32],
+    bin_hz: f64,
+    lines: &[CombLine],
+    f: f64,
+    spacing: f64,
+    slip: f64,
+) -> Option<f64> {
+    let (mut sum, mut weights, mut harmonics) = (0.0, 0.0, 0);
+    for line in lines {
+        let target = line.order as f64 * f * (1.0 + slip) + line.sideband * spacing * (1.0 + slip);
+        let half = (LINE_HALF_WIDTH * line.order as f64 * f / bin_hz).max(1.0);
+        let Some((_, e)) = line_excess(excess, target / bin_hz, half) else {
+            continue;
+        };
+        sum += line.weight * f64::from(e.max(0.0));
+        weights += line.weight;
+        if line.sideband == 0.0 {
+            harmonics += 1;
         }
-        (harmonics > 0).then(|| sum / weights)
     }
+    (harmonics > 0).then(|| sum / weights)
+}
+
+/// The first largest of `excess` within ±`half` bins of bin `centre`, and its bin; `None`
+/// when that reaches past either end.
+fn line_excess(excess: &[f32], centre: f64, half: f64) -> Option<(usize, f32)> {
+    let n = excess.len();
+    if centre <= 0.0 || centre + half >= (n - 1) as f64 {
+        return None;
+    }
+    let lo = (centre - half).round().max(1.0) as usize;
+    let hi = ((centre + half).round() as usize).clamp(lo, n - 1);
+    let mut best = (lo, f32::MIN);
+    for (bin, &e) in excess.iter().enumerate().take(hi + 1).skip(lo) {
+        if e > best.1 {
+            best = (bin, e);
+        }
+    }
+    Some(best)
 }
 
 /// `excess -= running median of excess over ±half bins`, the median evaluated every `half/4`
