@@ -390,6 +390,10 @@ pub struct FlagMessage {
     pub to: FlagLevel,
     pub score: f64,
     pub fault_frequency_hz: f64,
+    /// The largest score of the other faults in the same window: what the alert's confidence
+    /// weighs the flag's score against. Absent from logs written before 2026-11-26.
+    #[serde(default)]
+    pub runner_up_score: Option<f64>,
 }
 
 /// Something about the sensor or the bearing's life changed. Topic `/health/<sensor>/<axis>`.

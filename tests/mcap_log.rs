@@ -136,6 +136,7 @@ fn every_type() -> Vec<PipelineMessage> {
             to: FlagLevel::Alarm,
             score: 37.5,
             fault_frequency_hz: 107.36,
+            runner_up_score: Some(2.25),
         }),
         PipelineMessage::Health(HealthMessage {
             channel: c.clone(),

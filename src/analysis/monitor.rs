@@ -178,6 +178,8 @@ pub enum MonitorEvent<'a> {
         change: FlagChange,
         score: f64,
         frequency_hz: f64,
+        /// The largest score of the other faults in the same window (at least 1e-9).
+        runner_up: f64,
     },
     Stage(StageChange),
     /// A new point of the RMS trend, with the stage it was made in.
@@ -667,11 +669,18 @@ impl ChannelMonitor {
                         _ => 0.0,
                     };
                     if let Some(change) = flags[i].update(score, update.end_sample) {
+                        let runner_up = scores
+                            .iter()
+                            .enumerate()
+                            .filter(|&(j, _)| j != i)
+                            .map(|(_, s)| s.score)
+                            .fold(1e-9, f64::max);
                         on_event(MonitorEvent::Flag {
                             fault: *kind,
                             change,
                             score: scores[i].score,
                             frequency_hz: scores[i].frequency_hz,
+                            runner_up,
                         });
                     }
                 }

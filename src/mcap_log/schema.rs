@@ -512,6 +512,7 @@ mod tests {
                 to: FlagLevel::Alarm,
                 score: 9.0,
                 fault_frequency_hz: 162.2,
+                runner_up_score: Some(1.4),
             }),
             PipelineMessage::Health(HealthMessage {
                 channel: channel(),

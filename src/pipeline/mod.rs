@@ -577,6 +577,7 @@ fn handle_event(
             change,
             score,
             frequency_hz,
+            runner_up,
         } => {
             status.flag_changes += 1;
             PipelineMessage::Flag(FlagMessage {
@@ -587,6 +588,7 @@ fn handle_event(
                 to: change.to,
                 score,
                 fault_frequency_hz: frequency_hz,
+                runner_up_score: Some(runner_up),
             })
         }
         MonitorEvent::Velocity {

@@ -174,6 +174,47 @@ fn a_developing_outer_race_fault_raises_its_flag_after_onset_and_nothing_else() 
 }
 
 #[test]
+fn a_flag_carries_the_runner_up_of_its_own_window() {
+    let (counts, params) = counts(100.0, 30.0);
+    let mut monitor = ChannelMonitor::new(settings(params.fs_hz), params.frequencies(), None);
+    // (window end, the four scores) of every window; (at, fault index, runner-up) of every flag.
+    let mut windows = std::collections::BTreeMap::new();
+    let mut flags = Vec::new();
+    for (k, chunk) in counts.chunks(2_560).enumerate() {
+        monitor.push_counts((k * 2_560) as u64, chunk, SCALE, &mut |event| match event {
+            MonitorEvent::Window(w) => {
+                windows.insert(w.end_sample, w.scores.map(|s| s.score));
+            }
+            MonitorEvent::Flag {
+                fault,
+                change,
+                runner_up,
+                ..
+            } => flags.push((
+                change.at_sample,
+                fault.index(),
+                runner_up,
+                change.to > change.from,
+            )),
+            _ => {}
+        });
+    }
+    assert!(!flags.is_empty(), "no flag raised");
+    for (at, fault, runner_up, rising) in flags {
+        let scores = windows[&at];
+        let others = (0..4)
+            .filter(|&j| j != fault)
+            .map(|j| scores[j])
+            .fold(1e-9, f64::max);
+        assert_eq!(runner_up, others, "flag at {at}: scores {scores:?}");
+        assert!(
+            runner_up < scores[fault],
+            "the flag's fault leads its window"
+        );
+    }
+}
+
+#[test]
 fn the_same_samples_in_other_blocks_give_the_same_events() {
     let (counts, params) = counts(70.0, 20.0);
     let reference = run(&counts, &params, 4_096);

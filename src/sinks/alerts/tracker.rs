@@ -15,9 +15,7 @@ use super::payload::{
 };
 use crate::analysis::diagnosis::{score_evidence, DecisionRule};
 use crate::analysis::AnalysisSettings;
-use crate::messages::{
-    ChannelId, FlagMessage, IndicatorsMessage, PipelineMessage, TwinMessage, VelocityFlagMessage,
-};
+use crate::messages::{ChannelId, FlagMessage, PipelineMessage, TwinMessage, VelocityFlagMessage};
 use crate::messages::{FaultKind, FlagLevel};
 use crate::twin::diagnose::twin_adjusted_confidence;
 use std::collections::{BTreeMap, HashMap};
@@ -39,8 +37,6 @@ pub struct AlertTracker {
     history_size: u64,
     rule: DecisionRule,
     rates: HashMap<String, f64>,
-    /// Latest fault scores per channel, in [`FaultKind::ALL`] order.
-    scores: HashMap<ChannelId, [f64; 4]>,
     twins: HashMap<ChannelId, TwinSummary>,
     active: BTreeMap<AlertKey, Alert>,
 }
@@ -71,7 +67,6 @@ impl AlertTracker {
             history_size: history_size.max(2) as u64,
             rule: settings.decision_rule(),
             rates,
-            scores: HashMap::new(),
             twins: HashMap::new(),
             active: BTreeMap::new(),
         }
@@ -90,7 +85,6 @@ impl AlertTracker {
         publish: &mut impl FnMut(Alert),
     ) {
         match message {
-            PipelineMessage::Indicators(m) => self.note_scores(m),
             PipelineMessage::Twin(m) => self.note_twin(m),
             PipelineMessage::Flag(flag) => {
                 if let Some((key, alert)) = self.alert_for(flag, wall_time_ns) {
@@ -104,23 +98,6 @@ impl AlertTracker {
                 self.keep_active_in_history(wall_time_ns, publish);
             }
             _ => {}
-        }
-    }
-
-    /// Called for every window of every channel: updates in place, so only a channel's
-    /// first window allocates (its key).
-    fn note_scores(&mut self, m: &IndicatorsMessage) {
-        let scores = [
-            m.score_outer_race,
-            m.score_inner_race,
-            m.score_ball,
-            m.score_cage,
-        ];
-        match self.scores.get_mut(&m.channel) {
-            Some(slot) => *slot = scores,
-            None => {
-                self.scores.insert(m.channel.clone(), scores);
-            }
         }
     }
 
@@ -144,14 +121,9 @@ impl AlertTracker {
     fn alert_for(&self, flag: &FlagMessage, wall_time_ns: u64) -> Option<(AlertKey, Alert)> {
         let (fault, from, to) = (flag.fault, flag.from, flag.to);
         let index = fault.index();
-        let runner_up = self.scores.get(&flag.channel).map_or(1.0, |scores| {
-            scores
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != index)
-                .map(|(_, s)| *s)
-                .fold(1e-9, f64::max)
-        });
+        // Without a runner-up (a flag read from a log older than the field), the others are
+        // taken to be at the floor (score 1).
+        let runner_up = flag.runner_up_score.unwrap_or(1.0);
         let (_, mut confidence) = score_evidence(flag.score, runner_up, &self.rule);
         let twin = self.twins.get(&flag.channel);
         if let (Some(twin), true) = (twin, to != FlagLevel::Ok) {
@@ -290,6 +262,7 @@ mod tests {
             to,
             score: 40.0,
             fault_frequency_hz: 107.0,
+            runner_up_score: Some(1.0),
         })
     }
 
@@ -338,20 +311,6 @@ mod tests {
             sensor: "motor-de".into(),
             axis: "radial".into(),
         };
-        let scores = PipelineMessage::Indicators(IndicatorsMessage {
-            channel: channel.clone(),
-            end_sample: 0,
-            rpm: 1797.0,
-            band_hz: [2000.0, 4000.0],
-            rms: 1.0,
-            peak: 3.0,
-            crest: 3.0,
-            kurtosis: 5.0,
-            score_outer_race: 40.0,
-            score_inner_race: 5.0,
-            score_ball: 4.0,
-            score_cage: 2.0,
-        });
         let twin = |hypothesis: FaultKind| TwinMessage {
             channel: channel.clone(),
             end_sample: 0,
@@ -372,22 +331,23 @@ mod tests {
             residual: vec![],
             learned: None,
         };
-        let raise = flag("radial", OuterRace, OK, Watch, 10);
+        // The window's other scores: inner race 5, ball 4, cage 2.
+        let mut raise = flag("radial", OuterRace, OK, Watch, 10);
+        if let PipelineMessage::Flag(f) = &mut raise {
+            f.runner_up_score = Some(5.0);
+        }
         let mut plain = tracker(16);
-        observe(&mut plain, &scores);
         let base = observe(&mut plain, &raise)[0];
         assert!(base.twin_error.is_nan());
         assert!(base.confidence > 0.5 && base.confidence < 1.0, "{base:?}");
 
         let mut agreeing = tracker(16);
-        observe(&mut agreeing, &scores);
         agreeing.note_twin(&twin(OuterRace));
         let up = observe(&mut agreeing, &raise)[0];
         assert!(up.confidence > base.confidence);
         assert_eq!(up.twin_error, 0.2);
 
         let mut disagreeing = tracker(16);
-        observe(&mut disagreeing, &scores);
         disagreeing.note_twin(&twin(InnerRace));
         let down = observe(&mut disagreeing, &raise)[0];
         assert!(down.confidence < base.confidence);
