@@ -192,9 +192,8 @@ pub struct FaultScorer {
     harmonics: usize,
     spectrum_bins: usize,
     slots: Vec<Prepared>,
-    /// Bins the winner's comb explains, when scoring explained.
-    masked: Vec<bool>,
-    /// The prepared excess with those bins at the floor (0), when scoring explained.
+    /// When scoring explained: the prepared excess with the bins the winner's comb explains at
+    /// the floor (0).
     unexplained: Vec<f32>,
     /// Scratch for the medians.
     keys: Vec<i32>,
@@ -224,7 +223,6 @@ impl FaultScorer {
                     ..Prepared::default()
                 })
                 .collect(),
-            masked: Vec::with_capacity(spectrum_bins),
             unexplained: Vec::with_capacity(spectrum_bins),
             keys: Vec::with_capacity(spectrum_bins),
             knots: Vec::with_capacity(spectrum_bins),
@@ -351,20 +349,14 @@ impl FaultScorer {
         let Some(prepared) = self.slots.get(slot).filter(|p| !p.excess.is_empty()) else {
             return FaultScore::unscored(fault, freqs);
         };
-        mask_comb(
-            &mut self.masked,
-            prepared,
+        self.unexplained.clear();
+        self.unexplained.extend_from_slice(&prepared.excess);
+        floor_comb(
+            &mut self.unexplained,
+            prepared.bin_hz,
             self.harmonics.min(CAGE_HARMONICS),
             winner,
             freqs,
-        );
-        self.unexplained.clear();
-        self.unexplained.extend(
-            prepared
-                .excess
-                .iter()
-                .zip(&self.masked)
-                .map(|(&e, &masked)| if masked { 0.0 } else { e }),
         );
         self.comb_score(prepared, &self.unexplained, amplitude, fault, freqs)
     }
@@ -574,20 +566,17 @@ fn subtract_running_median(
     }
 }
 
-/// Marks in `masked` the bins of `prepared` that `winner`'s comb explains (see
-/// [`FaultScorer::score_explained`]); a cage comb has `cage_harmonics` harmonics.
-fn mask_comb(
-    masked: &mut Vec<bool>,
-    prepared: &Prepared,
+/// Sets to the floor (0) the bins of `excess` (spaced `bin_hz`) that `winner`'s comb explains
+/// (see [`FaultScorer::score_explained`]); a cage comb has `cage_harmonics` harmonics.
+fn floor_comb(
+    excess: &mut [f32],
+    bin_hz: f64,
     cage_harmonics: usize,
     winner: &FaultScore,
     freqs: &FaultFrequencies,
 ) {
-    let n = prepared.excess.len();
-    masked.clear();
-    masked.resize(n, false);
+    let n = excess.len();
     let f = winner.frequency_hz;
-    let bin = prepared.bin_hz;
     if !is_positive(f) {
         return;
     }
@@ -613,9 +602,9 @@ fn mask_comb(
         f64::INFINITY
     };
     let mut order = 1.0;
-    while (order * f - 2.0 * shaft) / bin < n as f64 && order <= last_order {
+    while (order * f - 2.0 * shaft) / bin_hz < n as f64 && order <= last_order {
         for offset in &offsets[..count] {
-            mark_line(masked, order * f + offset, order * f, bin);
+            floor_line(excess, order * f + offset, order * f, bin_hz);
         }
         order += 1.0;
     }
@@ -626,23 +615,24 @@ fn mask_comb(
     if matches!(winner.fault, FaultKind::OuterRace | FaultKind::Ball) {
         for order in 1..=cage_harmonics {
             let line = order as f64 * cage;
-            mark_line(masked, line, line, bin);
+            floor_line(excess, line, line, bin_hz);
         }
     }
 }
 
-/// Marks the bins of a line at `at_hz` whose harmonic sits at `harmonic_hz` (its width grows
-/// with the harmonic, as the scorer's search window does), plus one bin of leakage each side.
-fn mark_line(masked: &mut [bool], at_hz: f64, harmonic_hz: f64, bin_hz: f64) {
-    let Some(last) = masked.len().checked_sub(1) else {
+/// Sets to the floor the bins of a line at `at_hz` whose harmonic sits at `harmonic_hz` (its
+/// width grows with the harmonic, as the scorer's search window does), plus one bin of leakage
+/// each side.
+fn floor_line(excess: &mut [f32], at_hz: f64, harmonic_hz: f64, bin_hz: f64) {
+    let Some(last) = excess.len().checked_sub(1) else {
         return;
     };
     let centre = at_hz / bin_hz;
     let half = (LINE_HALF_WIDTH * harmonic_hz / bin_hz).max(1.5) + 1.0;
     let lo = (centre - half).max(0.0) as usize;
     let hi = ((centre + half).max(0.0) as usize).min(last);
-    for m in masked.iter_mut().take(hi + 1).skip(lo) {
-        *m = true;
+    for e in excess.iter_mut().take(hi + 1).skip(lo) {
+        *e = 0.0;
     }
 }
 
