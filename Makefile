@@ -9,6 +9,7 @@
 #   $(PREFIX)/bin/bearingd                         the binary
 #   $(PREFIX)/lib/systemd/system/bearingd.service  the unit (paths rewritten if PREFIX != /usr)
 #   $(PREFIX)/lib/sysusers.d/bearingd.conf         the static system user and group `bearingd`
+#   $(PREFIX)/lib/tmpfiles.d/bearingd.conf         /dev/cpu_dma_latency writable by that group
 #   $(PREFIX)/share/doc/bearingd/SYSTEMD.md        the unit's Documentation=
 #   /etc/bearingd/bearingd.toml                    the default config, never overwritten
 #
@@ -21,6 +22,7 @@ DESTDIR ?=
 BINDIR ?= $(PREFIX)/bin
 UNITDIR ?= $(PREFIX)/lib/systemd/system
 SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
+TMPFILESDIR ?= $(PREFIX)/lib/tmpfiles.d
 DOCDIR ?= $(PREFIX)/share/doc/bearingd
 # The config path is fixed: the unit and the docs name /etc/bearingd/bearingd.toml.
 CONFDIR = /etc/bearingd
@@ -54,6 +56,7 @@ install: build
 	    systemd/bearingd.service > "$(DESTDIR)$(UNITDIR)/bearingd.service"
 	chmod 0644 "$(DESTDIR)$(UNITDIR)/bearingd.service"
 	$(INSTALL) -D -m 0644 systemd/bearingd.sysusers "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf"
+	$(INSTALL) -D -m 0644 systemd/bearingd.tmpfiles "$(DESTDIR)$(TMPFILESDIR)/bearingd.conf"
 	$(INSTALL) -D -m 0644 docs/SYSTEMD.md "$(DESTDIR)$(DOCDIR)/SYSTEMD.md"
 	$(INSTALL) -d -m 0755 "$(DESTDIR)$(CONFDIR)"
 	@if [ -e "$(DESTDIR)$(CONFDIR)/bearingd.toml" ]; then \
@@ -65,6 +68,7 @@ install: build
 	@if [ -z "$(DESTDIR)" ]; then \
 	  if command -v systemd-sysusers >/dev/null; then systemd-sysusers bearingd.conf; \
 	  else echo "no systemd-sysusers: create the user with: useradd --system --no-create-home --home-dir /nonexistent --shell /usr/sbin/nologin bearingd"; fi; \
+	  if command -v systemd-tmpfiles >/dev/null; then systemd-tmpfiles --create bearingd.conf; fi; \
 	  if [ -d /run/systemd/system ]; then systemctl daemon-reload; fi; \
 	  echo "installed; edit $(CONFDIR)/bearingd.toml, then: systemctl enable --now bearingd"; \
 	fi
@@ -74,7 +78,8 @@ uninstall:
 	  echo "bearingd is enabled: systemctl disable --now bearingd first" >&2; exit 1; \
 	fi
 	rm -f "$(DESTDIR)$(BINDIR)/bearingd" "$(DESTDIR)$(UNITDIR)/bearingd.service" \
-	      "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf" "$(DESTDIR)$(DOCDIR)/SYSTEMD.md" \
+	      "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf" "$(DESTDIR)$(TMPFILESDIR)/bearingd.conf" \
+	      "$(DESTDIR)$(DOCDIR)/SYSTEMD.md" \
 	      "$(DESTDIR)$(DOCDIR)/bearingd.toml.default"
 	rmdir "$(DESTDIR)$(DOCDIR)" 2>/dev/null || true
 	@if [ -z "$(DESTDIR)" ] && [ -d /run/systemd/system ]; then systemctl daemon-reload; fi

@@ -20,7 +20,9 @@
 //! thousands of alerts, enough for p99 and p999 of a window's alert. Only the thresholds and
 //! the averaging differ from the default config; the analysis, band selections and twin re-fits
 //! are the default's. `BENCH_BEARINGD=path` runs another build of the daemon (a before/after
-//! comparison on the same machine load).
+//! comparison on the same machine load). `BENCH_CPU_WAKEUP_US=N` sets the daemon's
+//! `outputs.cpu_wakeup_latency_us` (the CPUs' wake-up latency capped while it runs; left out by
+//! default, as in the default config).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
@@ -35,8 +37,15 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// `sensors` simulated sensors; sensor j's outer race fails at 2 + 2.5 j s, or at 0 with
-/// `chatter` (then the flags chatter: see the module doc).
-fn write_config(dir: &Path, iox: &Path, sensors: usize, rate: usize, chatter: bool) -> PathBuf {
+/// `chatter` (then the flags chatter: see the module doc); `cpu_wakeup_us` is
+/// `outputs.cpu_wakeup_latency_us`.
+fn write_config(
+    dir: &Path,
+    iox: &Path,
+    (sensors, rate): (usize, usize),
+    chatter: bool,
+    cpu_wakeup_us: Option<u32>,
+) -> PathBuf {
     let mut text = String::new();
     if chatter {
         text.push_str(CHATTERING_THRESHOLDS);
@@ -60,6 +69,9 @@ iceoryx2_root = "{iox}"
         mcap = dir.join("mcap").display(),
         iox = iox.display()
     );
+    if let Some(us) = cpu_wakeup_us {
+        let _ = writeln!(text, "cpu_wakeup_latency_us = {us}");
+    }
     let path = dir.join("bench.toml");
     std::fs::write(&path, text).expect("write the bench config");
     path
@@ -73,6 +85,10 @@ fn main() {
     let rate = env_or("BENCH_RATE", 25_600);
     let windows = env_or("BENCH_WINDOWS", 0);
     let chatter = windows > 0;
+    let cpu_wakeup_us = std::env::var("BENCH_CPU_WAKEUP_US").ok().map(|v| {
+        v.parse()
+            .expect("BENCH_CPU_WAKEUP_US: a whole number of µs")
+    });
     let rounds = if chatter {
         1
     } else {
@@ -94,7 +110,7 @@ fn main() {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("bench dir");
         let iox = dir.join("iox");
-        let config = write_config(&dir, &iox, sensors, rate, chatter);
+        let config = write_config(&dir, &iox, (sensors, rate), chatter, cpu_wakeup_us);
         let prefix = format!("bdbench{}_", std::process::id());
         let mut daemon = Command::new(&daemon_path)
             .args([
@@ -148,13 +164,14 @@ fn main() {
     assert!(!latencies_ms.is_empty(), "no alert arrived");
     latencies_ms.sort_by(f64::total_cmp);
     println!(
-        "alert latency, {sensors} sensors at {rate} Hz, {rounds} round(s){}: {} alerts ({lost} lost), \
+        "alert latency, {sensors} sensors at {rate} Hz, {rounds} round(s){}{}: {} alerts ({lost} lost), \
          p50 {:.2} ms, p99 {:.2} ms, p999 {:.2} ms, max {:.2} ms, min {:.2} ms",
         if chatter {
             format!(", {duration_s} s = {windows}+ windows, chattering flags")
         } else {
             String::new()
         },
+        cpu_wakeup_us.map_or(String::new(), |us| format!(", CPU wake-up capped at {us} µs")),
         latencies_ms.len(),
         percentile(&latencies_ms, 50.0),
         percentile(&latencies_ms, 99.0),

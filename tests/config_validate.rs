@@ -28,6 +28,10 @@ fn problems(text: &str) -> Vec<ConfigProblem> {
     }
 }
 
+fn config_of(text: &str) -> Config {
+    config::parse(text, "test.toml").unwrap_or_else(|e| panic!("{e}"))
+}
+
 fn keys(problems: &[ConfigProblem]) -> Vec<&str> {
     problems.iter().map(|p| p.key.as_str()).collect()
 }
@@ -559,6 +563,24 @@ fn output_checks_say_why() {
         "{SENSOR}[outputs]\niceoryx2_root = \"/var/tmp/x\"\n"
     ));
     assert!(found[0].message.contains("PrivateTmp"), "{}", found[0]);
+}
+
+#[test]
+fn the_cpu_wakeup_latency_is_off_unless_given_and_then_within_0_to_1_s() {
+    assert_eq!(config_of(SENSOR).outputs.cpu_wakeup_latency_us, None);
+    let given = config_of(&format!("{SENSOR}[outputs]\ncpu_wakeup_latency_us = 0\n"));
+    assert_eq!(given.outputs.cpu_wakeup_latency_us, Some(0));
+    for bad in ["-1", "1000001", "\"low\""] {
+        let found = problems(&format!(
+            "{SENSOR}[outputs]\ncpu_wakeup_latency_us = {bad}\n"
+        ));
+        assert_eq!(
+            keys(&found),
+            ["outputs.cpu_wakeup_latency_us"],
+            "{bad}: {found:#?}"
+        );
+        found.iter().for_each(assert_has_fix);
+    }
 }
 
 #[test]

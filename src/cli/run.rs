@@ -261,6 +261,11 @@ pub(super) fn event_line(event: &DaemonEvent) -> String {
         ),
         DaemonEvent::Log(notice) => log_notice_line(notice),
         DaemonEvent::LoggingTo(path) => format!("bearingd: logging to {}", path.display()),
+        DaemonEvent::CpuLatencyCapped { latency_us } => format!(
+            "bearingd: CPU wake-up latency capped at {latency_us} µs while running \
+             (outputs.cpu_wakeup_latency_us)"
+        ),
+        DaemonEvent::CpuLatencyRefused(error) => format!("bearingd: warning: {error}"),
         DaemonEvent::AlertsOn { service, root } => format!(
             "bearingd: alerts on iceoryx2 service {service} (root {})",
             root.display()

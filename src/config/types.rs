@@ -340,6 +340,10 @@ pub struct OutputConfig {
     /// How often the learned state (health baselines) is saved to `state_dir` while running,
     /// in seconds of wall-clock time; it is also saved at every stop.
     pub state_save_interval_s: f64,
+    /// The CPUs' wake-up latency bearingd caps while it runs, in µs (Linux PM QoS,
+    /// `/dev/cpu_dma_latency`); `None`: the kernel's idle policy.
+    #[serde(default)]
+    pub cpu_wakeup_latency_us: Option<u32>,
 }
 
 impl OutputConfig {
@@ -372,6 +376,7 @@ impl Default for OutputConfig {
             iceoryx2_root: PathBuf::from("/run/bearingd/iceoryx2"),
             status_interval_s: 5.0,
             state_save_interval_s: 60.0,
+            cpu_wakeup_latency_us: None,
         }
     }
 }

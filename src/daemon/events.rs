@@ -35,6 +35,11 @@ pub enum DaemonEvent {
     Log(LogNotice),
     /// The MCAP log's first file is open.
     LoggingTo(PathBuf),
+    /// The CPUs' wake-up latency is capped at `latency_us` µs while bearingd runs
+    /// (`outputs.cpu_wakeup_latency_us`).
+    CpuLatencyCapped { latency_us: u32 },
+    /// The cap of `outputs.cpu_wakeup_latency_us` could not be held; bearingd runs on without.
+    CpuLatencyRefused(super::cpu_latency::CpuLatencyError),
     /// The alert service is up.
     AlertsOn { service: String, root: PathBuf },
     /// A dead iceoryx2 node under the root (a killed daemon's, or a killed publisher's): its

@@ -5,9 +5,11 @@
 //! - [`replay`]: logged raw samples through the same pipeline, into the same sinks.
 //! - [`events`]: what the daemon tells its operator, as typed events for the caller to show
 //!   (the daemon never prints).
+//! - [`cpu_latency`]: the CPUs' wake-up latency held down while it runs (an alert's latency).
 //! - [`lock`]: one owner per data directory (an advisory lock taken before anything is opened).
 //! - [`state`]: what is kept across restarts (the health baselines).
 
+pub mod cpu_latency;
 pub mod events;
 pub mod lock;
 pub mod replay;

@@ -37,6 +37,7 @@
 //! closing ends the analysis thread, which closes the re-fit queue, takes the last fits and
 //! closes the sink queue, which ends the sink thread.
 
+use super::cpu_latency::{CpuLatencyCap, CPU_LATENCY_DEVICE};
 use super::events::{DaemonEvent, Events};
 use super::lock::{DirLock, LockError};
 use super::state::{load_baselines, save_baselines};
@@ -57,7 +58,7 @@ use crate::sources::live::{forward, SENSOR_TIMEOUT};
 use crate::sources::sim::SimSource;
 use crate::sources::Arrived;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::mpsc;
 use std::time::Duration;
 use tokio::sync::{mpsc as async_mpsc, watch};
@@ -159,6 +160,7 @@ pub async fn run(
         sinks.push(Box::new(fleet));
     }
     let alerts = start_alerts(&config, &events)?;
+    let _cpu_latency = cap_cpu_latency(&config, &events);
     let pipeline = Pipeline::new(&config, &baselines);
 
     let (input_tx, input_rx) = async_mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
@@ -236,6 +238,22 @@ pub async fn run(
         alerts_published: analysis.alerts.map_or(0, |s| s.published),
         alerts_failed: analysis.alerts.map_or(0, |s| s.failed),
     })
+}
+
+/// Caps the CPUs' wake-up latency if the config asks to, for as long as the cap is kept; a
+/// cap that cannot be held is reported and the run goes on without it.
+fn cap_cpu_latency(config: &Config, events: &Events) -> Option<CpuLatencyCap> {
+    let latency_us = config.outputs.cpu_wakeup_latency_us?;
+    match CpuLatencyCap::hold(Path::new(CPU_LATENCY_DEVICE), latency_us) {
+        Ok(cap) => {
+            events(DaemonEvent::CpuLatencyCapped { latency_us });
+            Some(cap)
+        }
+        Err(error) => {
+            events(DaemonEvent::CpuLatencyRefused(error));
+            None
+        }
+    }
 }
 
 /// Creates `outputs.state_dir` if it is missing.

@@ -581,3 +581,65 @@ fn the_rms_trend_is_published_with_the_stage_and_predicts_only_once_the_limit_is
     assert!(first["rate_per_s"].as_f64().unwrap() > 0.0, "{first}");
     assert!(first["time_to_threshold_s"].is_f64(), "{first}");
 }
+
+/// The files `pid` holds open.
+fn open_files(pid: u32) -> Vec<PathBuf> {
+    std::fs::read_dir(format!("/proc/{pid}/fd"))
+        .map(|dir| {
+            dir.filter_map(|entry| std::fs::read_link(entry.ok()?.path()).ok())
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+#[test]
+fn the_cpu_wakeup_latency_is_capped_only_when_asked_and_for_as_long_as_the_daemon_runs() {
+    let device = Path::new(bearingd::daemon::cpu_latency::CPU_LATENCY_DEVICE);
+    if std::fs::OpenOptions::new()
+        .write(true)
+        .open(device)
+        .is_err()
+    {
+        let missing = format!(
+            "{} is not writable here (the kernel's PM QoS device; run the tests as root)",
+            device.display()
+        );
+        assert!(std::env::var("CI").as_deref() != Ok("true"), "{missing}");
+        eprintln!("skipping: {missing}");
+        return;
+    }
+    let dir = scratch_dir("daemon-cpu-latency");
+    for capped in [false, true] {
+        let replacement = if capped {
+            "cpu_wakeup_latency_us = 0"
+        } else {
+            "# cpu_wakeup_latency_us = 0"
+        };
+        let config = config_with(
+            &dir,
+            &format!("cap-{capped}"),
+            &[("# cpu_wakeup_latency_us = 0", replacement)],
+        );
+        let data = dir.join(format!("data-{capped}"));
+        let child = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+            .args(["run", "--quiet", "--duration", "3", "--config"])
+            .arg(&config)
+            .arg("--data-dir")
+            .arg(&data)
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(1_500));
+        let holds = open_files(child.id()).iter().any(|f| f == device);
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{stderr}");
+        assert_eq!(holds, capped, "capped {capped}: {stderr}");
+        assert_eq!(
+            stderr.contains("CPU wake-up latency capped at 0 µs"),
+            capped,
+            "{stderr}"
+        );
+    }
+}

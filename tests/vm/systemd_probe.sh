@@ -1,8 +1,8 @@
 #!/bin/sh
 # The probe of the systemd VM test (tests/vm/systemd_vm_test.sh), run in the VM as the oneshot
 # unit vmtest-probe.service after bearingd.service. Prints "VMTEST <name>: PASS|FAIL <detail>"
-# for: active, alert, stop, mcap-sent; and on any failure `systemctl status` and the journal of
-# bearingd ("DIAG" lines). Sends /var/log/bearingd/*.mcap base64-encoded over /dev/ttyS1.
+# for: active, cpu-latency, alert, stop, mcap-sent; and on any failure `systemctl status` and
+# the journal of bearingd ("DIAG" lines). Sends /var/log/bearingd/*.mcap base64-encoded over /dev/ttyS1.
 # No `set -e`: every check runs and reports, whatever the previous one did.
 set -u
 CONF=/etc/bearingd/bearingd.toml
@@ -39,6 +39,18 @@ else
   verdict active FAIL "bearingd is $state after waiting ${n}s"
 fi
 active_s=$(secs "$(prop ActiveEnterTimestampMonotonic)")
+
+# 1b. outputs.cpu_wakeup_latency_us (50 in the test config): the unit lets bearingd (no
+#     capabilities, a private /dev) open the PM QoS device, whose group tmpfiles.d set, and
+#     hold it for as long as it runs.
+pid=$(prop MainPID)
+capped=$(journalctl -u bearingd --no-pager -o cat 2>/dev/null | grep -a -m1 'wake-up latency')
+if ls -l "/proc/$pid/fd" 2>/dev/null | grep -q '/dev/cpu_dma_latency' &&
+  echo "$capped" | grep -q 'capped at 50 '; then
+  verdict cpu-latency PASS "bearingd (pid $pid) holds /dev/cpu_dma_latency ($(stat -c '%U:%G %a' /dev/cpu_dma_latency)): $capped"
+else
+  verdict cpu-latency FAIL "pid $pid, device $(stat -c '%U:%G %a' /dev/cpu_dma_latency 2>&1), journal: ${capped:-no line on the wake-up latency}"
+fi
 
 # 2. An alert over iceoryx2, received by the command-line subscriber, started as root the way
 #    an operator would (sudo bearingd alerts). iceoryx2 0.10 creates its files owner-only, so

@@ -127,6 +127,7 @@ impl Checker {
             "give how often the learned state is saved, in seconds, e.g. \
              state_save_interval_s = 60.0",
         );
+        let cpu_wakeup_latency_us = self.cpu_wakeup_latency(&raw.cpu_wakeup_latency_us);
         Some(OutputConfig {
             state_dir: state_dir?,
             mcap_dir: mcap_dir?,
@@ -138,7 +139,23 @@ impl Checker {
             iceoryx2_root: iceoryx2_root?,
             status_interval_s: status_interval_s?,
             state_save_interval_s: state_save_interval_s?,
+            cpu_wakeup_latency_us: cpu_wakeup_latency_us?,
         })
+    }
+
+    /// `outputs.cpu_wakeup_latency_us`: optional, 0 µs to 1 s.
+    fn cpu_wakeup_latency(&mut self, field: &Field<i64>) -> Option<Option<u32>> {
+        let key = "outputs.cpu_wakeup_latency_us";
+        let fix = "give the longest wake-up latency the CPUs may have while bearingd runs, in \
+                   µs (0: idle CPUs poll), e.g. cpu_wakeup_latency_us = 0, or leave the key out";
+        match self.get(key, field, fix) {
+            Got::Missing => Some(None),
+            Got::Invalid => None,
+            Got::Value(us) => self
+                .integer_in(key, us, 0, 1_000_000, fix)
+                .and_then(|us| u32::try_from(us).ok())
+                .map(Some),
+        }
     }
 
     pub(super) fn directory(
