@@ -537,7 +537,7 @@ fn refit_thread(
     requests: &TwinRequestQueue,
     fits: &mpsc::SyncSender<PipelineMessage>,
 ) -> u64 {
-    crate::pipeline::priority::lower_this_thread();
+    crate::pipeline::priority::idle_this_thread();
     let mut made = 0u64;
     let mut open = true;
     while open {
@@ -558,7 +558,7 @@ fn sink_thread(
     mut sinks: Vec<Box<dyn Sink>>,
     messages: &mpsc::Receiver<PipelineMessage>,
 ) -> Result<(Vec<FlagMessage>, u64), SinkError> {
-    crate::pipeline::priority::lower_this_thread();
+    crate::pipeline::priority::idle_this_thread();
     let mut flags = Vec::new();
     let mut count = 0u64;
     while let Ok(message) = messages.recv() {

@@ -32,7 +32,7 @@ impl BandWorker {
         std::thread::Builder::new()
             .name("bearingd-bands".into())
             .spawn(move || {
-                super::priority::lower_this_thread();
+                super::priority::idle_this_thread();
                 // Its own plans: the shared cache's lock is then never held for a selection.
                 let mut plans = FftPlans::default();
                 while let Ok((job, result)) = requests.recv() {

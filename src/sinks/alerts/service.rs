@@ -130,7 +130,7 @@ impl AlertPublisher {
             std::thread::Builder::new()
                 .name("bearingd-alerts".into())
                 .spawn(move || {
-                    crate::pipeline::priority::lower_this_thread();
+                    crate::pipeline::priority::idle_this_thread();
                     while let Err(mpsc::RecvTimeoutError::Timeout) =
                         stopped.recv_timeout(CONNECTION_PERIOD)
                     {
