@@ -4,10 +4,10 @@
 //! Why: an alert crosses three threads (the source's, the analysis', the subscriber's), and each
 //! one that was idle has to be woken. An idle CPU sleeps in a halt or deeper C-state, and
 //! leaving it costs tens of µs on a VM and up to hundreds on hardware with deep C-states: about
-//! 0.3 ms of an alert's p99 on our 2-vCPU VM (docs/PERFORMANCE.md). Linux's PM QoS lets a
-//! process cap that latency for as long as it keeps `/dev/cpu_dma_latency` open with the cap
-//! written in it; closing the file, also by a crash, lifts the cap. The price is idle power:
-//! with 0, an idle CPU polls instead of halting.
+//! 0.1 ms of an alert's p50 and p99 on our 2-vCPU VM (docs/PERFORMANCE.md). Linux's PM QoS
+//! lets a process cap that latency for as long as it keeps `/dev/cpu_dma_latency` open with the
+//! cap written in it; closing the file, also by a crash, lifts the cap. The kernel's cpuidle
+//! governor honours it; the price is idle power: with 0, an idle CPU polls instead of halting.
 
 use std::fs::{File, OpenOptions};
 use std::io::Write as _;
@@ -41,8 +41,9 @@ pub struct CpuLatencyError {
 fn fix_for(kind: std::io::ErrorKind) -> &'static str {
     match kind {
         std::io::ErrorKind::NotFound => {
-            "This kernel offers no PM QoS device; leave the key out (or use a kernel built \
-             with CONFIG_CPU_IDLE)"
+            "Under systemd with PrivateDevices=, the unit must bind it in (the shipped unit \
+             has BindPaths=-/dev/cpu_dma_latency); if this kernel has no such device, leave \
+             the key out"
         }
         std::io::ErrorKind::PermissionDenied => {
             "Let bearingd's user write it (`make install` puts the rule in \
