@@ -41,11 +41,14 @@ pub fn lower_this_thread() {
 /// thread finish its time slice first (up to milliseconds). Needs no privilege; if refused
 /// (a seccomp filter), the thread is lowered by nice instead.
 pub fn idle_this_thread() {
-    let param = libc::sched_param { sched_priority: 0 };
     #[allow(unsafe_code)]
-    // SAFETY: sched_setscheduler(2) changes only the calling thread's scheduling policy;
-    // `param` is a valid sched_param for the duration of the call.
-    let refused = unsafe { libc::sched_setscheduler(0, libc::SCHED_IDLE, &param) } != 0;
+    // SAFETY: sched_param is a plain C struct of integers (glibc has one field, musl more),
+    // valid all zero, which is the priority SCHED_IDLE requires; sched_setscheduler(2)
+    // changes only the calling thread's scheduling policy and only reads `param`.
+    let refused = unsafe {
+        let param: libc::sched_param = std::mem::zeroed();
+        libc::sched_setscheduler(0, libc::SCHED_IDLE, &param)
+    } != 0;
     if refused {
         lower_this_thread();
     }
