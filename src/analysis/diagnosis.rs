@@ -31,6 +31,11 @@ pub enum Verdict {
     InnerRace,
     Ball,
     Cage,
+    /// A damaged rolling element or a damaged cage, and the evidence cannot say which: the cage
+    /// comb stands, and the ball comb is significant beside it (a damaged ball, carried by the
+    /// cage through the load zone once per cage turn, makes a cage comb of its own, often the
+    /// taller one).
+    BallOrCage,
 }
 
 impl Verdict {
@@ -41,16 +46,27 @@ impl Verdict {
             Verdict::InnerRace => "inner_race",
             Verdict::Ball => "ball",
             Verdict::Cage => "cage",
+            Verdict::BallOrCage => "ball_or_cage",
         }
     }
 
+    /// The one fault the verdict names (`None` for none, and for a verdict naming two).
     pub fn fault(self) -> Option<FaultKind> {
+        match self.faults() {
+            [one] => Some(*one),
+            _ => None,
+        }
+    }
+
+    /// Every fault the verdict names: none, one, or the two it cannot tell apart.
+    pub fn faults(self) -> &'static [FaultKind] {
         match self {
-            Verdict::None => None,
-            Verdict::OuterRace => Some(FaultKind::OuterRace),
-            Verdict::InnerRace => Some(FaultKind::InnerRace),
-            Verdict::Ball => Some(FaultKind::Ball),
-            Verdict::Cage => Some(FaultKind::Cage),
+            Verdict::None => &[],
+            Verdict::OuterRace => &[FaultKind::OuterRace],
+            Verdict::InnerRace => &[FaultKind::InnerRace],
+            Verdict::Ball => &[FaultKind::Ball],
+            Verdict::Cage => &[FaultKind::Cage],
+            Verdict::BallOrCage => &[FaultKind::Ball, FaultKind::Cage],
         }
     }
 }
@@ -77,6 +93,9 @@ pub struct Diagnosis {
     /// apart (empty otherwise).
     pub candidates: Vec<FaultKind>,
     pub reason: String,
+    /// How the verdict's fault was named (`None` with a `none` verdict).
+    #[serde(skip)]
+    pub named: Option<Named>,
 }
 
 /// The thresholds of the decision (see the module docs).
@@ -109,6 +128,18 @@ impl DecisionRule {
     /// Significant and large enough to name whatever else the spectrum holds.
     pub fn detected(&self, score: &FaultScore) -> bool {
         self.significant(score) && score.score >= self.min_fault_score
+    }
+
+    /// How near `score` comes to being named on its own size and significance, in log units
+    /// (positive: it would be, were no other fault near it): the larger of the two ways of
+    /// naming, each the smaller of its size margin and its significance margin. What a fault's
+    /// scoring band is chosen by ([`super::band_search`]).
+    pub fn naming_margin(&self, score: &FaultScore) -> f64 {
+        let decades = |needed: f64| (score.significance - needed) * std::f64::consts::LN_10;
+        let size = |needed: f64| (score.score.max(1e-9) / needed).ln();
+        let by_size = size(self.min_fault_score).min(decades(self.min_significance()));
+        let alone = size(self.lone_fault_score).min(decades(2.0 * self.min_significance()));
+        by_size.max(alone)
     }
 
     /// Large enough to name when it stands alone (`runner_up`: the strongest other hypothesis
@@ -222,6 +253,28 @@ pub fn leader<'a>(scores: &'a [FaultScore], rule: &DecisionRule) -> Option<&'a F
     Some(cause.unwrap_or(top))
 }
 
+/// The ball hypothesis, when its comb shows beside the cage's: beyond noise at ten times the
+/// false-alarm rate and at least [`BALL_BEHIND_CAGE_SCORE`]. Then a cage comb may be the damaged
+/// ball's own cage-rate modulation (see [`Verdict::BallOrCage`]).
+///
+/// (choice) Ten times looser than naming: what is asked is not whether the ball is damaged but
+/// whether the cage can be named alone, and a cage named when the ball shows a sign of its own
+/// is the confident wrong answer a damaged ball gave.
+fn ball_behind_cage<'a>(scores: &'a [FaultScore], rule: &DecisionRule) -> Option<&'a FaultScore> {
+    let needed = rule.min_significance() - 1.0;
+    scores
+        .iter()
+        .find(|s| s.fault == FaultKind::Ball)
+        .filter(|ball| ball.significance >= needed && ball.score >= BALL_BEHIND_CAGE_SCORE)
+}
+
+/// (choice, on the simulator sweep) The ball comb a damaged ball shows beside the taller cage
+/// comb it makes is 2.3–2.8 even buried in noise (−10 dB); a damaged cage's own record shows a
+/// ball comb of 1.1–1.4, often beyond noise at p ≤ 10^-2 (the cage's knocks and rubbing modulate
+/// everything at FTF, the ball comb's sideband spacing). 1.8 lies between them (their geometric
+/// middle).
+const BALL_BEHIND_CAGE_SCORE: f64 = 1.8;
+
 /// How far a fault's `score` is from the decision boundary on scores alone (the alert's view:
 /// its significance was checked when its flag rose), in log units (positive: a fault), and the
 /// confidence that gives, in [0.5, 1]. Either way of naming counts (large enough and
@@ -248,6 +301,7 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
             confidence: 0.5,
             candidates: Vec::new(),
             reason: "no fault frequency could be scored".into(),
+            named: None,
         };
     };
     let best = contest.leader;
@@ -290,7 +344,24 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
         best.score,
         best.significance
     );
-    match contest.named(rule) {
+    let named = contest.named(rule);
+    if named.is_some() && best.fault == FaultKind::Cage {
+        if let Some(ball) = ball_behind_cage(scores, rule) {
+            return Diagnosis {
+                verdict: Verdict::BallOrCage,
+                confidence,
+                candidates: vec![FaultKind::Ball, FaultKind::Cage],
+                reason: format!(
+                    "{header} stands, but the ball comb is significant beside it ({:.1}, p = \
+                     10^-{:.1}): a damaged ball makes a cage comb too, so a rolling element or \
+                     the cage",
+                    ball.score, ball.significance
+                ),
+                named,
+            };
+        }
+    }
+    match named {
         Some(Named::BySize) => {
             return Diagnosis {
                 verdict: best.fault.into(),
@@ -300,6 +371,7 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
                     "{header} ≥ {:.1}, p ≤ {:.0e}; runner-up {runner_text}",
                     rule.min_fault_score, rule.false_alarm_rate
                 ),
+                named: Some(Named::BySize),
             }
         }
         Some(Named::Alone) => {
@@ -314,6 +386,7 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
                     rule.lone_score_ratio,
                     rule.false_alarm_rate * rule.false_alarm_rate
                 ),
+                named: Some(Named::Alone),
             }
         }
         None => {}
@@ -345,6 +418,7 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
         confidence,
         candidates,
         reason: format!("no clear fault: {why}"),
+        named: None,
     }
 }
 
@@ -462,6 +536,23 @@ mod tests {
             leader(&all, &rule()).map(|l| l.fault),
             Some(FaultKind::Cage)
         );
+    }
+
+    #[test]
+    fn a_cage_comb_with_the_ball_showing_beside_it_is_a_rolling_element_or_the_cage() {
+        // A lone cage comb with nothing else: the cage.
+        let d = verdict([(1.5, 0.5), (1.3, 1.0), (1.2, 0.4), (7.9, 20.0)]);
+        assert_eq!(d.verdict, Verdict::Cage, "{}", d.reason);
+        // A ball comb at the floor's level but beyond noise (what a damaged cage's knocks
+        // make of it): still the cage.
+        let d = verdict([(1.5, 0.5), (1.3, 1.0), (1.3, 2.5), (7.9, 20.0)]);
+        assert_eq!(d.verdict, Verdict::Cage, "{}", d.reason);
+        // A ball comb of its own beside it (2.0, p = 10^-2.5): either.
+        let d = verdict([(1.5, 0.5), (1.3, 1.0), (2.0, 2.5), (7.9, 20.0)]);
+        assert_eq!(d.verdict, Verdict::BallOrCage, "{}", d.reason);
+        assert_eq!(d.candidates, vec![FaultKind::Ball, FaultKind::Cage]);
+        assert_eq!(d.verdict.faults(), &[FaultKind::Ball, FaultKind::Cage]);
+        assert_eq!(d.verdict.fault(), None);
     }
 
     #[test]

@@ -17,6 +17,7 @@
 //!   of snapshots is walked by `offline::life`, which also needs the twin).
 
 pub mod band;
+pub mod band_search;
 pub mod band_selection;
 pub mod degradation;
 pub mod diagnosis;

@@ -1,12 +1,13 @@
 //! Whole-record analysis, as `bearingd analyze` runs it: indicators, the band scan, band
 //! selection, per-hypothesis band choice, fault scores and the verdict.
 //!
-//! (choice) Each hypothesis is scored in every candidate band wide enough to hold its comb
-//! (the full band always among them) and keeps the band where it shows best; its
-//! significance then pays for that choice (`−log10` of the number of bands tried, a Bonferroni
-//! bound). Band selection can thereby only add evidence, never cut it away.
+//! Each hypothesis is scored in every candidate band wide enough to hold its comb (the full
+//! band always among them) and keeps the band where its evidence against noise is strongest;
+//! its significance then pays for that search ([`super::band_search`]). Band selection can
+//! thereby only add evidence, never cut it away.
 
 use super::band::Band;
+use super::band_search::{candidate_bands, search_significance};
 use super::diagnosis::{diagnose, leader, Diagnosis};
 use super::envelope::{window_samples, EnvelopeSpectrum, FftPlans};
 use super::fault_bands::{FaultScore, FaultScorer};
@@ -45,6 +46,11 @@ pub struct Hypothesis {
     pub score: FaultScore,
     /// Index into [`RecordAnalysis::scan`]`.bands`.
     pub band_index: usize,
+    /// The chosen band's own significance; `score.significance` is the search's
+    /// ([`search_significance`] of this over `bands_searched` bands).
+    pub search_significance: f64,
+    /// How many candidate bands the fault was scored in.
+    pub bands_searched: usize,
 }
 
 /// Everything `analyze` reports about one record.
@@ -215,7 +221,7 @@ pub fn analyze_with_plans(
         let mut scorer =
             FaultScorer::new(settings.fault_tolerance, settings.harmonics, spectrum_bins);
         let candidates = candidate_bands(&scan, selected_band_index, settings, freqs);
-        let penalty = (candidates.len().max(1) as f64).log10();
+        let rule = settings.decision_rule();
         // Each candidate band's spectrum is prepared once (slot = its place among the
         // candidates), then scored for every fault and on what the leader does not explain.
         for (slot, &i) in candidates.iter().enumerate() {
@@ -232,16 +238,25 @@ pub fn analyze_with_plans(
                         None => scorer.score_prepared(slot, amplitude, kind, freqs),
                         Some(w) => scorer.score_explained_prepared(slot, amplitude, kind, freqs, w),
                     };
-                    score.significance = (score.significance - penalty).max(0.0);
+                    let own = score.significance;
+                    score.significance = search_significance(own, candidates.len());
                     Hypothesis {
                         score,
                         band_index: i,
+                        search_significance: own,
+                        bands_searched: candidates.len(),
                     }
                 })
-                .max_by(|a, b| a.score.score.total_cmp(&b.score.score))
+                .max_by(|a, b| {
+                    rule.naming_margin(&a.score)
+                        .total_cmp(&rule.naming_margin(&b.score))
+                        .then(a.search_significance.total_cmp(&b.search_significance))
+                })
                 .unwrap_or(Hypothesis {
                     score: FaultScore::unscored(kind, freqs),
                     band_index: selected_band_index,
+                    search_significance: 0.0,
+                    bands_searched: 0,
                 })
         };
         let hypotheses: Vec<Hypothesis> = FaultKind::ALL
@@ -249,7 +264,6 @@ pub fn analyze_with_plans(
             .map(|&kind| best_band(&mut scorer, kind, None))
             .collect();
         let scores: Vec<FaultScore> = hypotheses.iter().map(|h| h.score).collect();
-        let rule = settings.decision_rule();
         let explained: Vec<FaultScore> = match leader(&scores, &rule) {
             Some(leader) => FaultKind::ALL
                 .iter()
@@ -278,33 +292,6 @@ pub fn analyze_with_plans(
             reported_band_index,
         })
     }
-}
-
-/// The bands a hypothesis may be scored in: the full band, the selected band and, with
-/// refinement, every band of the scan at least as wide as the combs need.
-fn candidate_bands(
-    scan: &BandScan,
-    selected: usize,
-    settings: &AnalysisSettings,
-    freqs: &FaultFrequencies,
-) -> Vec<usize> {
-    if matches!(settings.band_selection, BandSelection::Fixed { .. }) {
-        return vec![selected];
-    }
-    let need = comb_width_hz(freqs, settings.harmonics);
-    let widest = (0..scan.bands.len()).max_by(|&a, &b| {
-        scan.bands[a]
-            .band
-            .width_hz()
-            .total_cmp(&scan.bands[b].band.width_hz())
-    });
-    (0..scan.bands.len())
-        .filter(|&i| {
-            i == selected
-                || Some(i) == widest
-                || (settings.refine_band_by_snr && scan.bands[i].band.width_hz() >= need)
-        })
-        .collect()
 }
 
 /// Windows a record should hold at least for a stable Welch average.

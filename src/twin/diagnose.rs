@@ -278,7 +278,7 @@ pub fn combine(scores: &Diagnosis, twin: &TwinDiagnosis) -> (Diagnosis, bool, St
                 twin.margin
             ),
         ),
-        verdict if verdict.fault() == Some(twin_fault) => {
+        verdict if verdict.faults().contains(&twin_fault) => {
             combined.confidence = twin_adjusted_confidence(scores.confidence, true, twin.margin);
             (true, format!("the twin agrees: {} fits best (error {:.3}, margin {:.3})", twin_fault.name(), twin.best_fit().error, twin.margin))
         }
