@@ -1,5 +1,10 @@
-//! A channel's band selection as a job: cut from the history at the sample it is due, computed
-//! anywhere, used at a sample fixed in advance.
+//! A channel's band selection and evidence as a job: cut from the history at the sample it is
+//! due, computed anywhere, used at a sample fixed in advance.
+//!
+//! The job is `bearingd analyze` on the channel's history (the horizon since its last gap or
+//! restart, at most the configured length): it chooses the bands the rolling spectra follow and
+//! gives the verdict on all of that evidence, which the channel's flags follow. One analysis for
+//! both paths is what makes the daemon's flags on a complete recording equal `analyze`'s verdict.
 //!
 //! Why: a band selection (the whole-record analysis of the last 10 s, plus the speed estimate)
 //! costs 30–100 ms per 25.6 kHz channel. Run inline it holds the analysis thread, and every block
@@ -8,7 +13,9 @@
 //! a delay in samples, and waits for it there if it is late. So the result takes effect at the
 //! same sample whatever thread ran it and however long it took: a replay repeats every event.
 
+use super::diagnosis::{Named, Verdict};
 use super::envelope::FftPlans;
+use super::fault_bands::FaultScore;
 use super::monitor::SpeedMode;
 use super::record::analyze_with_plans;
 use super::speed::estimate_shaft_hz;
@@ -46,6 +53,54 @@ pub struct BandResult {
     /// One band per fault kind ([`FaultKind::ALL`] order) and the method's choice; `None` when
     /// no speed was usable or the analysis failed (the bands stay as they are).
     pub bands: Option<([Band; 4], Band)>,
+    /// The verdict on the job's history; `None` with `bands`.
+    pub evidence: Option<Evidence>,
+}
+
+/// The verdict of the whole-record analysis of a channel's history.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evidence {
+    /// Every fault's score in its best band ([`FaultKind::ALL`] order), as `analyze` reports
+    /// them.
+    pub scores: [FaultScore; 4],
+    /// The verdict (its faults are the ones whose flags it raises) and how it was named.
+    pub verdict: Verdict,
+    pub named: Option<Named>,
+    /// Samples the history held.
+    pub samples: usize,
+}
+
+impl Evidence {
+    /// One line for the log: what the verdict rests on and says, e.g. `verdict on 10.0 s:
+    /// outer_race (outer_race 6.2 at p = 10^-9.1, inner_race 3.3, ball 2.0, cage 1.8)`.
+    pub fn describe(&self, seconds: f64) -> String {
+        let said = match self.verdict {
+            Verdict::None => "no clear fault",
+            verdict => verdict.name(),
+        };
+        let scores: Vec<String> = self
+            .scores
+            .iter()
+            .map(|s| {
+                format!(
+                    "{} {:.1} at p = 10^-{:.1}",
+                    s.fault.name(),
+                    s.score,
+                    s.significance
+                )
+            })
+            .collect();
+        format!("verdict on {seconds:.1} s: {said} ({})", scores.join(", "))
+    }
+
+    /// The largest score of the faults other than `fault` (at least 1e-9).
+    pub fn runner_up(&self, fault: FaultKind) -> f64 {
+        self.scores
+            .iter()
+            .filter(|s| s.fault != fault)
+            .map(|s| s.score)
+            .fold(1e-9, f64::max)
+    }
 }
 
 /// A shaft rate given or estimated, if usable: finite, positive, at most `max_shaft_hz`.
@@ -93,25 +148,38 @@ impl BandJob {
             return BandResult {
                 estimated_shaft_hz,
                 bands: None,
+                evidence: None,
             };
         }
-        let bands = analyze_with_plans(plans, &signal, self.fs_hz, &freqs, &self.analysis)
-            .ok()
-            .map(|analysis| {
-                let band_of = |kind: FaultKind| {
-                    analysis
-                        .hypotheses
-                        .iter()
-                        .find(|h| h.score.fault == kind)
-                        .map_or(analysis.selected_band(), |h| {
-                            analysis.scan.bands[h.band_index].band
-                        })
-                };
-                (FaultKind::ALL.map(band_of), analysis.selected_band())
-            });
+        let analysis = analyze_with_plans(plans, &signal, self.fs_hz, &freqs, &self.analysis).ok();
+        let evidence = analysis.as_ref().map(|analysis| Evidence {
+            scores: FaultKind::ALL.map(|kind| {
+                analysis
+                    .hypotheses
+                    .iter()
+                    .find(|h| h.score.fault == kind)
+                    .map_or(FaultScore::unscored(kind, &freqs), |h| h.score)
+            }),
+            verdict: analysis.diagnosis.verdict,
+            named: analysis.diagnosis.named,
+            samples: signal.len(),
+        });
+        let bands = analysis.map(|analysis| {
+            let band_of = |kind: FaultKind| {
+                analysis
+                    .hypotheses
+                    .iter()
+                    .find(|h| h.score.fault == kind)
+                    .map_or(analysis.selected_band(), |h| {
+                        analysis.scan.bands[h.band_index].band
+                    })
+            };
+            (FaultKind::ALL.map(band_of), analysis.selected_band())
+        });
         BandResult {
             estimated_shaft_hz,
             bands,
+            evidence,
         }
     }
 }

@@ -34,6 +34,8 @@ pub struct FaultFlag {
     level: FlagLevel,
     /// Where the score started to ask for a level other than the current one, and which.
     pending: Option<(FlagLevel, u64)>,
+    /// The sample of the last change of level (0 before any).
+    changed_at: u64,
 }
 
 impl FaultFlag {
@@ -42,6 +44,7 @@ impl FaultFlag {
             settings,
             level: FlagLevel::Ok,
             pending: None,
+            changed_at: 0,
         }
     }
 
@@ -87,6 +90,19 @@ impl FaultFlag {
 
     /// Feeds the score of the window ending at `end_sample`; returns a change of level, if any.
     pub fn update(&mut self, score: f64, end_sample: u64) -> Option<FlagChange> {
+        self.update_over(score, end_sample, end_sample)
+    }
+
+    /// Feeds a score that rests on the evidence from `from_sample` to `end_sample` (a whole
+    /// stretch of signal analysed at once): a level it asks for anew counts as asked since
+    /// `from_sample`, though not from before the flag's last change, so the on- and off-delays
+    /// are met when that evidence spans them.
+    pub fn update_over(
+        &mut self,
+        score: f64,
+        from_sample: u64,
+        end_sample: u64,
+    ) -> Option<FlagChange> {
         let wanted = self.wanted(score);
         if wanted == self.level {
             self.pending = None;
@@ -100,7 +116,7 @@ impl FaultFlag {
             {
                 since
             }
-            _ => end_sample,
+            _ => from_sample.max(self.changed_at).min(end_sample),
         };
         self.pending = Some((wanted, since));
         let delay = if wanted > self.level {
@@ -116,6 +132,7 @@ impl FaultFlag {
             };
             self.level = wanted;
             self.pending = None;
+            self.changed_at = end_sample;
             return Some(change);
         }
         None
@@ -182,5 +199,19 @@ mod tests {
         assert_eq!(flag.update(11.0, 500).map(|c| c.to), Some(FlagLevel::Watch));
         flag.update(1.0, 600);
         assert_eq!(flag.update(1.0, 900).map(|c| c.to), Some(FlagLevel::Ok));
+    }
+
+    #[test]
+    fn evidence_over_a_stretch_counts_from_its_start_but_not_before_the_last_change() {
+        let mut flag = FaultFlag::new(settings());
+        // Evidence over samples 0..150 asks for alarm: it spans the 100-sample on-delay.
+        let change = flag.update_over(20.0, 0, 150).unwrap();
+        assert_eq!((change.to, change.at_sample), (FlagLevel::Alarm, 150));
+        // Evidence over 0..400 says nothing is there: asked since the change at 150, 250 < 300.
+        assert_eq!(flag.update_over(0.0, 0, 400), None);
+        assert_eq!(
+            flag.update_over(0.0, 100, 450).map(|c| c.to),
+            Some(FlagLevel::Ok)
+        );
     }
 }

@@ -5,16 +5,17 @@
 //! Every decision is taken in sample time, so a replay of the raw samples reproduces every event
 //! at the same sample (the replay test checks it).
 //!
-//! - Bands: every `band_period_samples` the last `band_history_samples` go through the same
-//!   whole-record analysis as `bearingd analyze` (kurtogram/GK plus per-fault SNR refinement),
-//!   and the rolling envelope follows one band per fault kind. Until the first selection the
-//!   channel is learning and raises no flag.
-//! - Scores, flags: each fault's score comes from its own band's averaged envelope spectrum;
-//!   the others are re-scored with the strongest explained away, and the verdict's rule
-//!   ([`Contest::lead`]: significant against noise, separable from every other detected
-//!   hypothesis) picks the fault whose score drives its flag; the others' flags see 0.
-//!   (choice) A second fault at the same time shows once it leads: this keeps one strong
-//!   fault's leakage into the other fault bands from raising false alarms.
+//! - Evidence and bands: every `band_period_samples` the channel's history (the samples since
+//!   its last gap or restart, at most `band_history_samples`: the evidence horizon) goes
+//!   through the same whole-record analysis as `bearingd analyze` (band search, scores, the
+//!   verdict). Its bands are the ones the rolling envelope follows (one per fault kind); its
+//!   verdict is what the **flags** follow: the fault it names asks for its level, the others
+//!   for ok, each counted over the history it rests on ([`FaultFlag::update_over`]). So the
+//!   flags accumulate the evidence of the whole horizon, not of one window, and the end of a
+//!   signal ([`ChannelMonitor::finish`]) leaves them on the verdict `analyze` gives the same
+//!   samples. Until the first selection the channel is learning and raises no flag.
+//! - Scores: every hop, each fault's score in its own band's rolling (averaged) envelope
+//!   spectrum, for the log, the status and the twin: what the spectrum shows now.
 //! - Health: the stage tracker, fed with each window's kurtosis and RMS, and the RMS trend
 //!   (one point per `trend.point_s`, fitted against the failure limit once degrading).
 //! - Sensor: clipping (counts at full scale) and a flat line (no change for a second) are
@@ -41,11 +42,11 @@
 //!
 //! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
 
+use super::band_selection::Evidence;
 use super::band_selection::{
     scaled, usable_shaft_hz, BandJob, BandResult, BandSelector, InlineSelector,
 };
 use super::degradation::{RmsTrend, TrendPoint};
-use super::diagnosis::{leader, Contest, Named};
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::{FaultFlag, FlagChange, FlagSettings};
@@ -192,10 +193,14 @@ pub enum MonitorEvent<'a> {
         active: bool,
         at_sample: u64,
     },
+    /// A band selection's result: its bands and the verdict on its history (from
+    /// `evidence_from` to `at_sample`), which the flags follow.
     Bands {
         at_sample: u64,
         bands: [Band; 4],
         selected: Band,
+        evidence: Option<Evidence>,
+        evidence_from: u64,
     },
     /// A velocity reading ([`super::iso`]) and the zone flag's level after it.
     Velocity {
@@ -242,8 +247,6 @@ pub struct ChannelMonitor {
     health: HealthTracker,
     trend: RmsTrend,
     scores: [FaultScore; 4],
-    /// The others' scores with the leader explained away (the leader's own entry unused).
-    explained: [FaultScore; 4],
     bands: [Band; 4],
     bands_known: bool,
     /// The last `band_history_samples` samples, for band re-selection, kept as the sensor's
@@ -269,6 +272,13 @@ pub struct ChannelMonitor {
     band_delay_samples: u64,
     /// Where the band selection under way (if any) is used.
     band_result_at: Option<u64>,
+    /// The first sample the selection under way analyses.
+    band_job_from: u64,
+    /// The sample the newest selection's history ended at (0 before any).
+    evidence_until: u64,
+    /// The fewest samples of history a selection analyses (one window, or the whole history
+    /// if shorter).
+    min_evidence_samples: usize,
     /// The velocity severity and its zone flag (`None` when off).
     velocity: Option<(VelocityTracker, FaultFlag)>,
 }
@@ -351,14 +361,16 @@ impl ChannelMonitor {
                 settings.trend.confidence,
             ),
             scores,
-            explained: scores,
             bands: [whole; 4],
             bands_known: false,
             history: vec![0; settings.band_history_samples.max(window)],
             history_scale: 1.0,
             history_at: 0,
             history_filled: 0,
-            next_band_selection: settings.band_history_samples.max(window) as u64,
+            // The first selection when the history is full, or one band period in if that
+            // comes first (with the evidence there is by then).
+            next_band_selection: (settings.band_history_samples.max(window) as u64)
+                .min(settings.band_period_samples.max(window as u64)),
             band_phase_left: settings.band_phase_samples,
             next_sample: 0,
             scratch: vec![0.0; CHUNK],
@@ -370,6 +382,9 @@ impl ChannelMonitor {
             band_selector: Box::new(InlineSelector::default()),
             band_delay_samples: 0,
             band_result_at: None,
+            band_job_from: 0,
+            evidence_until: 0,
+            min_evidence_samples: window.min(settings.band_history_samples.max(1)),
             freqs,
             orders,
             speed_known,
@@ -452,7 +467,7 @@ impl ChannelMonitor {
             && self.speed_known
             && !estimated
             && !self.bands_known
-            && self.history_filled == self.history.len()
+            && self.history_filled >= self.min_evidence_samples
         {
             self.start_band_selection(on_event);
         }
@@ -571,10 +586,11 @@ impl ChannelMonitor {
             self.analyse(&samples[..take], on_event);
             samples = &samples[take..];
             if self.next_sample >= self.next_band_selection {
-                if self.history_filled == self.history.len() {
+                let enough = self.history_filled >= self.min_evidence_samples;
+                if enough {
                     self.start_band_selection(on_event);
                 }
-                let phase = if self.history_filled == self.history.len() {
+                let phase = if enough {
                     std::mem::take(&mut self.band_phase_left)
                 } else {
                     0
@@ -605,18 +621,14 @@ impl ChannelMonitor {
             });
         }
 
-        let rule = self.settings.analysis.decision_rule();
         let ChannelMonitor {
             rolling,
             velocity,
             scorer,
-            flags,
             health,
             trend,
             scores,
-            explained,
             bands,
-            bands_known,
             freqs,
             speed_known,
             ..
@@ -626,8 +638,7 @@ impl ChannelMonitor {
             // Before the first band selection there are no band engines: nothing to score; nor
             // without a speed to score against. Each band's spectrum is prepared once, in the
             // scorer slot of its engine (at most the fault's index; faults whose best band is
-            // the same share it), then scored for its faults and, below, on what the leader
-            // does not explain.
+            // the same share it), then scored for its faults.
             let slot = |i: usize| update.band_of.get(i).copied().unwrap_or(i);
             let mut prepared = [false; FaultKind::ALL.len()];
             for (i, kind) in FaultKind::ALL.iter().enumerate() {
@@ -639,51 +650,6 @@ impl ChannelMonitor {
                     scorer.prepare(slot(i), spectrum, update.bin_hz, freqs);
                 }
                 scores[i] = scorer.score_prepared(slot(i), spectrum, *kind, freqs);
-            }
-            // The flags first, so that their alerts leave before the window's indicators,
-            // health stage and trend are computed.
-            if *bands_known && speed_known {
-                // Only the leading fault feeds its flag (the verdict's rule); the others see 0
-                // and fall.
-                let leader = leader(&scores[..], &rule)
-                    .and_then(|l| FaultKind::ALL.iter().position(|&k| k == l.fault))
-                    .unwrap_or(0);
-                for (i, kind) in FaultKind::ALL.iter().enumerate() {
-                    explained[i] = if i == leader {
-                        FaultScore::unscored(*kind, freqs)
-                    } else {
-                        let spectrum = update.band(i).map_or(&[][..], |b| b.averaged_amplitude());
-                        let winner = &scores[leader];
-                        scorer.score_explained_prepared(slot(i), spectrum, *kind, freqs, winner)
-                    };
-                }
-                let lead =
-                    Contest::new(&scores[..], &explained[..], &rule).and_then(|c| c.lead(&rule));
-                for (i, kind) in FaultKind::ALL.iter().enumerate() {
-                    let score = match lead {
-                        Some((fault, Named::BySize)) if fault == *kind => scores[i].score,
-                        // A comb named because it stands alone is at watch at least.
-                        Some((fault, Named::Alone)) if fault == *kind => {
-                            scores[i].score.max(flags[i].settings().watch_score)
-                        }
-                        _ => 0.0,
-                    };
-                    if let Some(change) = flags[i].update(score, update.end_sample) {
-                        let runner_up = scores
-                            .iter()
-                            .enumerate()
-                            .filter(|&(j, _)| j != i)
-                            .map(|(_, s)| s.score)
-                            .fold(1e-9, f64::max);
-                        on_event(MonitorEvent::Flag {
-                            fault: *kind,
-                            change,
-                            score: scores[i].score,
-                            frequency_hz: scores[i].frequency_hz,
-                            runner_up,
-                        });
-                    }
-                }
             }
             if let Some((tracker, flag)) = velocity.as_mut().filter(|(t, _)| t.shares_windows()) {
                 let reading =
@@ -721,6 +687,15 @@ impl ChannelMonitor {
         });
     }
 
+    /// The history's filled part as counts, oldest first.
+    fn history_counts(&self) -> Vec<i16> {
+        let n = self.history.len();
+        let filled = self.history_filled.min(n);
+        (0..filled)
+            .map(|i| self.history[(self.history_at + n - filled + i) % n])
+            .collect()
+    }
+
     fn history_sample(&self, index: usize) -> f32 {
         (f64::from(self.history[index]) * self.history_scale) as f32
     }
@@ -732,11 +707,9 @@ impl ChannelMonitor {
         if self.band_result_at.is_some() || (!self.speed_known && !estimating) {
             return;
         }
-        let n = self.history.len();
-        let (newer, older) = self.history.split_at(self.history_at);
-        let mut counts = Vec::with_capacity(n);
-        counts.extend_from_slice(older);
-        counts.extend_from_slice(newer);
+        let counts = self.history_counts();
+        self.band_job_from = self.next_sample - counts.len() as u64;
+        self.evidence_until = self.next_sample;
         self.band_selector.start(std::sync::Arc::new(BandJob {
             counts,
             scale: self.history_scale,
@@ -761,6 +734,7 @@ impl ChannelMonitor {
         let Some(BandResult {
             estimated_shaft_hz,
             bands,
+            evidence,
         }) = self.band_selector.finish()
         else {
             return;
@@ -780,7 +754,53 @@ impl ChannelMonitor {
             at_sample: self.next_sample,
             bands,
             selected,
+            evidence,
+            evidence_from: self.band_job_from,
         });
+        if let Some(evidence) = evidence {
+            self.follow_evidence(&evidence, on_event);
+        }
+    }
+
+    /// The flags follow the verdict on the selection's history: the fault it names asks for
+    /// its score's level (watch at least), every other fault for ok; a level asked for counts
+    /// as asked since the history's first sample ([`FaultFlag::update_over`]), so a verdict on
+    /// more evidence than the on-delay raises its flag at once.
+    fn follow_evidence(&mut self, evidence: &Evidence, on_event: &mut impl FnMut(MonitorEvent)) {
+        let at = self.next_sample;
+        let from = self.band_job_from;
+        for (i, kind) in FaultKind::ALL.iter().enumerate() {
+            let score = &evidence.scores[i];
+            let asked = if evidence.named.is_some() && evidence.verdict.faults().contains(kind) {
+                score.score.max(self.flags[i].settings().watch_score)
+            } else {
+                0.0
+            };
+            if let Some(change) = self.flags[i].update_over(asked, from, at) {
+                on_event(MonitorEvent::Flag {
+                    fault: *kind,
+                    change,
+                    score: score.score,
+                    frequency_hz: score.frequency_hz,
+                    runner_up: evidence.runner_up(*kind),
+                });
+            }
+        }
+    }
+
+    /// The end of the signal (a replay's, an evaluation's, or a clean stop): the selection
+    /// under way is used now, and the evidence not yet analysed (the samples since the last
+    /// selection) gets a last selection over the history, used at once, so that the flags end
+    /// on the verdict of everything the channel saw.
+    pub fn finish(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
+        if self.band_result_at.is_some() {
+            self.use_band_result(on_event);
+        }
+        if self.next_sample > self.evidence_until && self.history_filled > 0 {
+            let delay = std::mem::replace(&mut self.band_delay_samples, 0);
+            self.start_band_selection(on_event);
+            self.band_delay_samples = delay;
+        }
     }
 
     /// Clipping starts at the first count at full scale and ends after a quiet stretch as long

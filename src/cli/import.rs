@@ -126,10 +126,12 @@ pub(super) fn write_raw_log(log: &RawLog) -> Result<WrittenLog, CliError> {
          --config {out}/replay.toml after editing it)\n\
          [[sensors]]\nid = \"{sensor}\"\ntransport = \"shm\"\nsample_rate_hz = {fs}\nscale_g_per_count = {scale:e}\naxes = [\"radial\"]\nbearing = \"{bearing_spec}\"\n\
          [sensors.speed]\nsource = \"fixed\"\nrpm = {rpm}\n\n\
-         # A recording is short: choose bands every 3 s and raise flags after 1 s.\n\
-         [analysis]\nband_period_s = 3.0\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 5.0\nbaseline_windows = 5\n\n\
+         # A recording is one piece of evidence: the verdict rests on all of it (up to 600 s), as\n\
+         # `bearingd analyze`'s does, decided at its end; flags rise on 1 s of evidence.\n\
+         [analysis]\nband_period_s = {horizon}\nevidence_horizon_s = {horizon}\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 5.0\nbaseline_windows = 5\n\n\
          [outputs]\nstate_dir = \"{out}/state\"\nmcap_dir = \"{out}/replay\"\n",
         what = log.what,
+        horizon = evidence_horizon_s(log.samples.len(), fs),
         out = log.out.display(),
         sensor = log.sensor,
     );
@@ -180,6 +182,17 @@ pub(super) fn write_raw_log(log: &RawLog) -> Result<WrittenLog, CliError> {
         scale,
     })
 }
+
+/// The evidence horizon (and band period) an imported recording is replayed with: its whole
+/// length, so that its verdict is decided once, on all of it, up to the longest horizon the
+/// config allows; written with enough digits to hold every sample.
+fn evidence_horizon_s(samples: usize, fs_hz: f64) -> String {
+    let seconds = (samples as f64 / fs_hz).clamp(1e-3, MAX_HORIZON_S);
+    format!("{:.6}", (seconds * 1e6).ceil() / 1e6)
+}
+
+/// The longest evidence horizon `[analysis] evidence_horizon_s` accepts.
+const MAX_HORIZON_S: f64 = 600.0;
 
 /// When the recording began, ns since the Unix epoch, and where that came from: the date an IMS
 /// file's name states, else the file's modification time (the best a .mat or CSV file says),

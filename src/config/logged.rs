@@ -47,6 +47,10 @@ pub fn config_from_log(json: &str) -> Result<Config, String> {
         "analysis.band_period_s".into(),
     );
     check(
+        positive(config.evidence_horizon_s) && config.evidence_horizon_s <= 3600.0,
+        "analysis.evidence_horizon_s".into(),
+    );
+    check(
         positive(config.twin.refit_period_s) && positive(config.twin.window_s),
         "twin".into(),
     );

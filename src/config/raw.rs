@@ -127,6 +127,7 @@ pub(crate) struct RawAnalysis {
     pub band_hz: Field<Vec<f64>>,
     pub refine_band_by_snr: Field<bool>,
     pub band_period_s: Field<f64>,
+    pub evidence_horizon_s: Field<f64>,
     pub min_band_hz: Field<f64>,
     pub fault_tolerance: Field<f64>,
     pub harmonics: Field<i64>,

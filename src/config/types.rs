@@ -20,6 +20,12 @@ pub struct Config {
     /// How often the resonance band is chosen again, in seconds (`analysis.band_period_s`).
     /// Kept here because [`AnalysisSettings`] has no field for it yet.
     pub band_period_s: f64,
+    /// The most signal, in seconds, a channel's evidence (each band selection's whole-record
+    /// analysis, whose verdict the flags follow) spans: the samples since the channel's last
+    /// gap or restart, up to this (`analysis.evidence_horizon_s`). Logs written before it
+    /// existed read as the 10 s those versions analysed.
+    #[serde(default = "default_evidence_horizon_s")]
+    pub evidence_horizon_s: f64,
     /// The signal-model twin (`[twin]`).
     pub twin: TwinConfig,
     /// Fault-flag thresholds and the health baseline (`[thresholds]`).
@@ -440,4 +446,12 @@ impl FleetConfig {
     pub fn queue_max_bytes(&self) -> u64 {
         (self.queue_max_mb * (1u64 << 20) as f64) as u64
     }
+}
+
+/// Seconds of history a channel's evidence spans unless configured (and in logs written before
+/// the key existed).
+pub const DEFAULT_EVIDENCE_HORIZON_S: f64 = 10.0;
+
+fn default_evidence_horizon_s() -> f64 {
+    DEFAULT_EVIDENCE_HORIZON_S
 }

@@ -16,6 +16,10 @@
 //!
 //! The twin's re-fits run inline here (the live run does them on their own thread): they do
 //! not influence flags, so the flags of a replay equal the live run's at the same samples.
+//!
+//! A run's end is the end of its evidence: the channels decide once more on what they have not
+//! analysed yet ([`Pipeline::finish`]), as the daemon does when it stops cleanly. So an imported
+//! recording ends on `analyze`'s verdict of the same samples.
 
 use super::events::{DaemonEvent, Events};
 use crate::analysis::health::{baselines_from_json, Baseline};
@@ -274,6 +278,15 @@ impl<'a> RunReplay<'a> {
                     flag_changes: summary.flags.len(),
                 });
             }
+        }
+        // The run's end: the channels decide on the evidence they have not analysed yet, as
+        // the live daemon does when it stops cleanly.
+        self.pipeline.finish(&mut |output| outputs.push(output));
+        if !outputs.is_empty() && self.sinks.is_none() {
+            self.open(open_sinks, summary)?;
+        }
+        for output in outputs.drain(..) {
+            self.deliver(output, &mut summary.flags);
         }
         let Some(sinks) = self.sinks.as_mut() else {
             return Ok(());

@@ -453,6 +453,14 @@ impl AnalysisThread {
     /// One input through the pipeline; its outputs to the alerts and the re-fit as they come,
     /// then, in their order, to the sinks.
     fn analyse(&mut self, arrived: Arrived) {
+        let Arrived { input, wall_ns } = arrived;
+        self.deliver(wall_ns, |pipeline, mut out| {
+            pipeline.handle(input, &mut out)
+        });
+    }
+
+    /// Runs `step` on the pipeline and delivers its outputs (`wall_ns`: when its input arrived).
+    fn deliver(&mut self, wall_ns: u64, step: impl FnOnce(&mut Pipeline, &mut dyn FnMut(Output))) {
         let AnalysisThread {
             pipeline,
             alerts,
@@ -462,10 +470,10 @@ impl AnalysisThread {
             events,
             ..
         } = self;
-        pipeline.handle(arrived.input, &mut |output| match output {
+        step(pipeline, &mut |output| match output {
             Output::Message(message) => {
                 if let Some(alerts) = alerts.as_mut() {
-                    alerts.observe(&message, arrived.wall_ns, &mut |failed| {
+                    alerts.observe(&message, wall_ns, &mut |failed| {
                         #[cfg(feature = "shm")]
                         events(DaemonEvent::AlertFailed(failed));
                         #[cfg(not(feature = "shm"))]
@@ -508,8 +516,12 @@ impl AnalysisThread {
         let _ = self.sinks.send(fit);
     }
 
-    /// The inputs have ended: the last fits, the baselines, the unknown channels, the alerts.
+    /// The inputs have ended: the channels' last verdict on the evidence not yet analysed (as a
+    /// replay of this run ends), the last fits, the baselines, the unknown channels, the alerts.
     fn stop(mut self) -> AnalysisSummary {
+        self.deliver(crate::clock::wall_clock_now_ns(), |pipeline, mut out| {
+            pipeline.finish(&mut out)
+        });
         // Closing the re-fit queue ends the re-fit thread once it has handed over its last fit.
         self.twin_requests = None;
         while let Ok(fit) = self.fits.recv() {

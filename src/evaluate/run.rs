@@ -313,26 +313,29 @@ fn run_monitor(
     let mut first_flag = None;
     let mut bands_known = false;
     let (mut scored, mut flagged) = (0u64, 0u64);
+    let mut watch = |event: MonitorEvent| match event {
+        MonitorEvent::Bands { .. } => bands_known = true,
+        MonitorEvent::Flag { fault, change, .. } => {
+            let index = FaultKind::ALL.iter().position(|&k| k == fault).unwrap_or(0);
+            level[index] = change.to;
+            highest[index] = highest[index].max(change.to);
+            if change.to > change.from && first_flag.is_none() {
+                first_flag = Some(change.at_sample as f64 / fs);
+            }
+        }
+        MonitorEvent::Window(_) if bands_known => {
+            scored += 1;
+            if level.iter().any(|&l| l > FlagLevel::Ok) {
+                flagged += 1;
+            }
+        }
+        _ => {}
+    };
     for (i, block) in counts.chunks(BLOCK).enumerate() {
-        monitor.push_counts((i * BLOCK) as u64, block, scale, &mut |event| match event {
-            MonitorEvent::Bands { .. } => bands_known = true,
-            MonitorEvent::Flag { fault, change, .. } => {
-                let index = FaultKind::ALL.iter().position(|&k| k == fault).unwrap_or(0);
-                level[index] = change.to;
-                highest[index] = highest[index].max(change.to);
-                if change.to > change.from && first_flag.is_none() {
-                    first_flag = Some(change.at_sample as f64 / fs);
-                }
-            }
-            MonitorEvent::Window(_) if bands_known => {
-                scored += 1;
-                if level.iter().any(|&l| l > FlagLevel::Ok) {
-                    flagged += 1;
-                }
-            }
-            _ => {}
-        });
+        monitor.push_counts((i * BLOCK) as u64, block, scale, &mut watch);
     }
+    // The record's end, as a replay's: the last verdict on what was not analysed yet.
+    monitor.finish(&mut watch);
     let raised: Vec<FaultKind> = FaultKind::ALL
         .into_iter()
         .zip(highest)

@@ -236,13 +236,11 @@ pub fn monitor_settings(
 /// Seconds of sample time between two logged spectra.
 const SPECTRUM_EVERY_S: f64 = 1.0;
 
-/// Seconds of signal a band re-selection analyses: the last 10 s, or one band period if that is
-/// shorter (a short recording replayed with a short period still gets its bands).
+/// Seconds of signal a band selection (and the verdict the flags follow) analyses at most: the
+/// evidence horizon.
 pub fn band_history_s(config: &Config) -> f64 {
-    config.band_period_s.min(MAX_BAND_HISTORY_S)
+    config.evidence_horizon_s
 }
-
-const MAX_BAND_HISTORY_S: f64 = 10.0;
 
 /// Seconds of sample time from a band selection's start (on the worker thread) to the sample
 /// where its bands are used: 2 s, or half the band period if that is shorter. Long enough for
@@ -501,6 +499,26 @@ impl Pipeline {
         }
     }
 
+    /// The end of the input (a replay run's end, a clean stop): every channel decides once more
+    /// on the evidence it has not yet analysed ([`ChannelMonitor::finish`]), so its flags end
+    /// on the verdict of everything it saw.
+    pub fn finish(&mut self, out: &mut impl FnMut(Output)) {
+        let spectrum_every_s = self.spectrum_every_s;
+        for (id, c) in &mut self.channels {
+            let fs = c.fs_hz;
+            let Channel {
+                monitor,
+                status,
+                next_spectrum,
+                ..
+            } = c;
+            monitor.finish(&mut |event| {
+                handle_event(id, fs, spectrum_every_s, next_spectrum, status, event, out)
+            });
+            c.status.flags = c.monitor.flag_levels();
+        }
+    }
+
     fn sensor_event(&mut self, sensor: &str, lost: bool, out: &mut impl FnMut(Output)) {
         for (id, c) in self
             .channels
@@ -698,14 +716,24 @@ fn handle_event(
             at_sample,
             bands,
             selected,
+            evidence,
+            evidence_from,
         } => PipelineMessage::Health(HealthMessage {
             channel: channel.clone(),
             end_sample: at_sample,
             kind: HealthKind::Bands,
             stage: None,
             detail: format!(
-                "bands re-selected: outer {} inner {} ball {} cage {} (method's choice {})",
-                bands[0], bands[1], bands[2], bands[3], selected
+                "bands re-selected: outer {} inner {} ball {} cage {} (method's choice {}){}",
+                bands[0],
+                bands[1],
+                bands[2],
+                bands[3],
+                selected,
+                evidence.map_or(String::new(), |e| format!(
+                    "; {}",
+                    e.describe((at_sample.saturating_sub(evidence_from)) as f64 / fs)
+                ))
             ),
         }),
     };

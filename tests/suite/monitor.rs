@@ -174,44 +174,47 @@ fn a_developing_outer_race_fault_raises_its_flag_after_onset_and_nothing_else() 
 }
 
 #[test]
-fn a_flag_carries_the_runner_up_of_its_own_window() {
+fn a_flag_follows_the_verdict_of_its_evidence_and_carries_its_runner_up() {
     let (counts, params) = counts(100.0, 30.0);
     let mut monitor = ChannelMonitor::new(settings(params.fs_hz), params.frequencies(), None);
-    // (window end, the four scores) of every window; (at, fault index, runner-up) of every flag.
-    let mut windows = std::collections::BTreeMap::new();
+    // The verdict of every band selection, by the sample it is used at; every flag change.
+    let mut verdicts = std::collections::BTreeMap::new();
     let mut flags = Vec::new();
+    let mut watch = |event: MonitorEvent| match event {
+        MonitorEvent::Bands {
+            at_sample,
+            evidence: Some(evidence),
+            ..
+        } => {
+            verdicts.insert(at_sample, evidence);
+        }
+        MonitorEvent::Flag {
+            fault,
+            change,
+            runner_up,
+            score,
+            ..
+        } => flags.push((change, fault, runner_up, score)),
+        _ => {}
+    };
     for (k, chunk) in counts.chunks(2_560).enumerate() {
-        monitor.push_counts((k * 2_560) as u64, chunk, SCALE, &mut |event| match event {
-            MonitorEvent::Window(w) => {
-                windows.insert(w.end_sample, w.scores.map(|s| s.score));
-            }
-            MonitorEvent::Flag {
-                fault,
-                change,
-                runner_up,
-                ..
-            } => flags.push((
-                change.at_sample,
-                fault.index(),
-                runner_up,
-                change.to > change.from,
-            )),
-            _ => {}
-        });
+        monitor.push_counts((k * 2_560) as u64, chunk, SCALE, &mut watch);
     }
+    monitor.finish(&mut watch);
     assert!(!flags.is_empty(), "no flag raised");
-    for (at, fault, runner_up, rising) in flags {
-        let scores = windows[&at];
-        let others = (0..4)
-            .filter(|&j| j != fault)
-            .map(|j| scores[j])
-            .fold(1e-9, f64::max);
-        assert_eq!(runner_up, others, "flag at {at}: scores {scores:?}");
-        if rising {
-            assert!(
-                runner_up < scores[fault],
-                "a rising flag's fault leads its window"
-            );
+    for (change, fault, runner_up, score) in flags {
+        let evidence = verdicts
+            .get(&change.at_sample)
+            .unwrap_or_else(|| panic!("flag at {} without a verdict there", change.at_sample));
+        let own = evidence.scores[fault.index()].score;
+        assert_eq!(score, own, "flag at {}", change.at_sample);
+        assert_eq!(runner_up, evidence.runner_up(fault));
+        let named = evidence.verdict.faults().contains(&fault);
+        if change.to > change.from {
+            assert!(named, "a flag rises for a fault its verdict names");
+            assert!(runner_up < own, "a rising flag's fault leads its verdict");
+        } else {
+            assert!(!named, "a flag falls when its verdict stops naming it");
         }
     }
 }

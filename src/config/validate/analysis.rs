@@ -2,12 +2,16 @@
 
 use super::*;
 
+/// (choice) The longest evidence horizon: a channel keeps its horizon as 16-bit counts, 2 bytes
+/// per sample (10 minutes at 25.6 kHz: 31 MB per channel).
+const MAX_EVIDENCE_HORIZON_S: f64 = 600.0;
+
 impl Checker {
     pub(super) fn analysis(
         &mut self,
         raw: &RawAnalysis,
         sensors: &[CheckedSensor],
-    ) -> Option<(AnalysisSettings, f64)> {
+    ) -> Option<(AnalysisSettings, f64, f64)> {
         let d = AnalysisSettings::default();
         let window_s = self.number(
             "analysis.window_s",
@@ -46,6 +50,14 @@ impl Checker {
             DEFAULT_BAND_PERIOD_S,
             Limits::above_to(0.0, DAY_S),
             "give how often the band is chosen again, in seconds, e.g. band_period_s = 20.0",
+        );
+        let evidence_horizon_s = self.number(
+            "analysis.evidence_horizon_s",
+            &raw.evidence_horizon_s,
+            DEFAULT_EVIDENCE_HORIZON_S,
+            Limits::above_to(0.0, MAX_EVIDENCE_HORIZON_S),
+            "give how many seconds of signal a channel's verdict rests on, e.g. \
+             evidence_horizon_s = 10.0",
         );
         let min_band_hz = self.min_band(&raw.min_band_hz, sensors);
         let fault_tolerance = self.number(
@@ -123,6 +135,7 @@ impl Checker {
                 lone_score_ratio: lone_score_ratio?,
             },
             band_period_s?,
+            evidence_horizon_s?,
         ))
     }
 

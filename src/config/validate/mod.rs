@@ -27,7 +27,8 @@ use super::raw::{
 use super::types::{
     CanConfig, Config, OutputConfig, SensorConfig, ShmConfig, SimConfig, SimFault, Speed,
     ThresholdConfig, Transport, TwinConfig, DEFAULT_AXIS, DEFAULT_BAND_PERIOD_S,
-    DEFAULT_CAN_INTERFACE, DEFAULT_MAX_RPM_FACTOR, DEFAULT_SCALE_G_PER_COUNT, DEFAULT_SPEED_SEARCH,
+    DEFAULT_CAN_INTERFACE, DEFAULT_EVIDENCE_HORIZON_S, DEFAULT_MAX_RPM_FACTOR,
+    DEFAULT_SCALE_G_PER_COUNT, DEFAULT_SPEED_SEARCH,
 };
 
 /// Longest sensor id, in characters.
@@ -60,7 +61,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
     ) {
         (
             Some(sensors),
-            Some((analysis, band_period_s)),
+            Some((analysis, band_period_s, evidence_horizon_s)),
             Some(twin),
             Some(thresholds),
             Some(outputs),
@@ -70,6 +71,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
             sensors,
             analysis,
             band_period_s,
+            evidence_horizon_s,
             twin,
             thresholds,
             outputs,

@@ -220,7 +220,9 @@ pub fn differences(logged: &Config, given: &Config) -> Vec<String> {
     for (section, same) in [
         (
             "[analysis]",
-            logged.analysis == given.analysis && logged.band_period_s == given.band_period_s,
+            logged.analysis == given.analysis
+                && logged.band_period_s == given.band_period_s
+                && logged.evidence_horizon_s == given.evidence_horizon_s,
         ),
         ("[twin]", logged.twin == given.twin),
         ("[thresholds]", logged.thresholds == given.thresholds),
