@@ -51,6 +51,21 @@ impl Predicted {
         Predicted::Several,
     ];
 
+    /// What the flags say, from the highest level each fault's flag reached (outer, inner,
+    /// ball, cage): the one fault whose flag rose, none, or several.
+    pub fn of_flags(highest: [FlagLevel; 4]) -> Self {
+        let mut raised = FaultKind::ALL
+            .into_iter()
+            .zip(highest)
+            .filter(|(_, level)| *level > FlagLevel::Ok)
+            .map(|(kind, _)| kind);
+        match (raised.next(), raised.next()) {
+            (None, _) => Predicted::None,
+            (Some(kind), None) => Predicted::Fault(kind),
+            (Some(_), Some(_)) => Predicted::Several,
+        }
+    }
+
     /// What a verdict says. Written against the verdict's public meaning (`fault()` names one
     /// fault or none), so that a verdict added later for "both named, not separable" counts as
     /// ambiguous without a change here.
@@ -70,6 +85,8 @@ pub struct RecordOutcome {
     pub predicted: Predicted,
     pub confidence: f64,
     pub reason: String,
+    /// With a `none` verdict: the faults detected but not told apart.
+    pub candidates: Vec<FaultKind>,
     /// Fault scores in outer, inner, ball, cage order.
     pub scores: [f64; 4],
 }
@@ -286,7 +303,8 @@ pub fn run_case(
     }
 }
 
-fn record_outcome(
+/// What the record path concluded, from its analysis.
+pub fn record_outcome(
     diagnosis: &Diagnosis,
     analysis: &crate::analysis::RecordAnalysis,
 ) -> RecordOutcome {
@@ -295,6 +313,7 @@ fn record_outcome(
         predicted: Predicted::of_verdict(diagnosis.verdict),
         confidence: diagnosis.confidence,
         reason: diagnosis.reason.clone(),
+        candidates: diagnosis.candidates.clone(),
         scores: FaultKind::ALL.map(|kind| analysis.score(kind)),
     }
 }
@@ -333,22 +352,11 @@ fn run_monitor(
             _ => {}
         });
     }
-    let raised: Vec<FaultKind> = FaultKind::ALL
-        .into_iter()
-        .zip(highest)
-        .filter(|(_, l)| *l > FlagLevel::Ok)
-        .map(|(k, _)| k)
-        .collect();
-    let predicted = match raised.as_slice() {
-        [] => Predicted::None,
-        [one] => Predicted::Fault(*one),
-        _ => Predicted::Several,
-    };
     MonitorOutcome {
         highest,
         first_flag_s: first_flag,
         windows_scored: scored,
         windows_flagged: flagged,
-        predicted,
+        predicted: Predicted::of_flags(highest),
     }
 }
