@@ -204,8 +204,10 @@ fn run_recordings(args: &EvaluateArgs) -> Result<(), CliError> {
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new(tasks.len() as u64);
         bar.set_style(
-            indicatif::ProgressStyle::with_template("evaluate {bar:20} {pos}/{len} ({eta}) {msg}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            indicatif::ProgressStyle::with_template(
+                "evaluate {bar:20} {pos}/{len} ({eta}) {wide_msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         bar
     });
