@@ -6,14 +6,16 @@
 //! (`scripts/module_deps.py` checks this in CI, and that there is no import cycle).
 //!
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
+//! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
+//!   SNR, speed and bearing through the real pipeline, and recordings of a manifest through
+//!   `analyze` and through the daemon's replay (`bearingd evaluate`). Above [`daemon`]: it
+//!   replays imported recordings through it, as a user would.
 //! - [`daemon`]: wiring only: `run` and `replay` lock the data dir, start sources, the pipeline
 //!   and sinks, and stop them; what happens is reported as typed events, never printed.
 //! - [`sources`]: SocketCAN, iceoryx2, the simulated sensor and MCAP replay → sample blocks in
 //!   sample time, counting gaps, restarts, silent sensors and malformed frames.
 //! - [`sinks`]: where the pipeline's messages go: the MCAP log writer, iceoryx2 alerts, the
 //!   systemd notify protocol, the fleet bridge (MQTT Sparkplug B with store-and-forward).
-//! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
-//!   SNR, speed and bearing through the real pipeline (`bearingd evaluate`).
 //! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
 //! - [`report`]: what `analyze` and `trend` show: JSON, text and the figure, from one report.
 //! - [`life`]: a bearing's life of snapshots, in time order, through the daemon's health tracker

@@ -279,17 +279,31 @@ pub fn analyze(
     request: &AnalyzeRequest,
     analyzer: &mut RecordAnalyzer,
 ) -> Result<AnalyzeOutcome, OfflineError> {
-    let (recording, simulated) = match &request.file {
-        Some(path) => (read_recording(path, &request.read)?, false),
-        None => (demo_recording(), true),
-    };
+    match &request.file {
+        Some(path) => {
+            let recording = read_recording(path, &request.read)?;
+            analyze_recording(&recording, false, request, analyzer)
+        }
+        None => analyze_recording(&demo_recording(), true, request, analyzer),
+    }
+}
+
+/// [`analyze`] of a recording already read (`simulated`: the demo record); `request.file` and
+/// `request.read` are not looked at. For callers that also need the samples, such as
+/// `evaluate --recordings`, which imports the same recording for the daemon.
+pub fn analyze_recording(
+    recording: &Recording,
+    simulated: bool,
+    request: &AnalyzeRequest,
+    analyzer: &mut RecordAnalyzer,
+) -> Result<AnalyzeOutcome, OfflineError> {
     let Conditions {
         fs_hz,
         rpm,
         rpm_source,
         bearing,
         warnings,
-    } = resolve_conditions(&recording, request, simulated)?;
+    } = resolve_conditions(recording, request, simulated)?;
     let file = recording.path.display().to_string();
     let freqs = bearing.fault_frequencies(rpm / 60.0);
     let samples: Vec<f32> = recording.samples.iter().map(|&x| x as f32).collect();

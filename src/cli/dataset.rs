@@ -5,9 +5,10 @@
 //! that `bearingd replay` reads as the daemon's own. Records are made on all cores, with a
 //! progress bar on a terminal.
 
-use super::import::{write_raw_log, RawLog};
+use super::import::raw_log_error;
 use super::CliError;
 use crate::bearing::BearingGeometry;
+use crate::sinks::mcap::raw_log::{write_raw_log, RawLog};
 use crate::twin::dataset::{DatasetRecord, DatasetSpec};
 use clap::Args;
 use ndarray::{Array1, Array2};
@@ -214,5 +215,6 @@ fn write_logs(
                 what: &format!("record {} of a bearingd dataset", record.index),
             })
             .map(|_| ())
+            .map_err(raw_log_error)
         })
 }

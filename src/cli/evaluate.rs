@@ -1,9 +1,15 @@
 //! `bearingd evaluate`: sweep the simulator through the real pipeline and report how well the
-//! detector does (see `crate::evaluate` and docs/DIAGNOSIS.md).
+//! detector does; with `--recordings`, real recordings of a manifest through `analyze` and
+//! through the daemon's replay (see `crate::evaluate` and docs/DIAGNOSIS.md).
 
 use super::CliError;
+use crate::evaluate::recordings::{
+    evaluate_recordings, plan, render_recordings, tally, Entry, Manifest, RecordingsOptions,
+    RecordingsReport, Said,
+};
 use crate::evaluate::{
-    pd_figure, render_csv, render_tables, run_sweep, summarize, Bench, Summary, Sweep,
+    pd_figure, render_csv, render_tables, run_sweep, summarize, Bench, Path as JudgedPath, Summary,
+    Sweep,
 };
 use crate::twin::Nuisance;
 use clap::Args;
@@ -14,11 +20,26 @@ use std::time::Instant;
 
 #[derive(Args)]
 pub struct EvaluateArgs {
+    /// Instead of the simulator: every record of this manifest (CSV with a header: `file`
+    /// relative to its folder, and `fault`, `note` or `life_frac` for the truth; `channel_var`,
+    /// `fs_hz`, `rpm` where the file does not say) through `bearingd analyze` and through
+    /// `bearingd import` + `replay`; writes recordings.json. May be given several times.
+    #[arg(long, value_name = "MANIFEST", conflicts_with_all = ["quick", "config", "no_nuisance"])]
+    recordings: Vec<PathBuf>,
+    /// With --recordings: also the other channels of each record (CWRU fan end and base,
+    /// every axis of other files; IMS snapshots are always evaluated on all eight).
+    #[arg(long, requires = "recordings")]
+    all_channels: bool,
+    /// With --recordings: exit 1 if any answer is confident and wrong, the paths disagree on
+    /// any record, or any record fails (CI).
+    #[arg(long, requires = "recordings")]
+    strict: bool,
     /// The small sweep CI runs (both bearings at nominal speed, default severity, the
     /// simulator's default noise and 0 dB SNR, healthy records) instead of the full one.
     #[arg(long)]
     quick: bool,
-    /// Directory for results.json, results.csv, table.txt and pd_vs_snr.svg (created).
+    /// Directory for results.json, results.csv, table.txt and pd_vs_snr.svg (with
+    /// --recordings: recordings.json and recordings.txt) (created).
     #[arg(long, default_value = "evaluate-results")]
     out: PathBuf,
     /// Seed of the sweep: the same seed gives the same records and results.
@@ -46,6 +67,9 @@ struct ResultsFile<'a> {
 }
 
 pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
+    if !args.recordings.is_empty() {
+        return run_recordings(args);
+    }
     let bench = match &args.config {
         Some(path) => Bench {
             config: crate::config::load(path).map_err(CliError::input)?,
@@ -60,20 +84,8 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     if args.no_nuisance {
         sweep.nuisance = Nuisance::none();
     }
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        CliError::input(format!(
-            "{}: cannot create the output directory: {e}; give a writable --out DIR",
-            args.out.display()
-        ))
-    })?;
-    let threads = args.jobs.unwrap_or_else(|| {
-        std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)
-    });
-    if threads == 0 {
-        return Err(CliError::input(
-            "--jobs 0: give at least one thread, e.g. --jobs 2",
-        ));
-    }
+    create_out(&args.out)?;
+    let threads = threads(args)?;
 
     let total = sweep.cases().len();
     eprintln!(
@@ -103,12 +115,7 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     let tables = render_tables(&summary);
     print!("{tables}");
 
-    let write = |name: &str, bytes: &[u8]| -> Result<PathBuf, CliError> {
-        let path = args.out.join(name);
-        std::fs::write(&path, bytes)
-            .map_err(|e| CliError::failure(format!("{}: cannot write: {e}", path.display())))?;
-        Ok(path)
-    };
+    let write = |name: &str, bytes: &[u8]| write_out(&args.out, name, bytes);
     let json = serde_json::to_vec_pretty(&ResultsFile {
         sweep: &sweep,
         summary: &summary,
@@ -139,4 +146,123 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
 
 fn display(path: &Path) -> String {
     path.display().to_string()
+}
+
+fn create_out(out: &Path) -> Result<(), CliError> {
+    std::fs::create_dir_all(out).map_err(|e| {
+        CliError::input(format!(
+            "{}: cannot create the output directory: {e}; give a writable --out DIR",
+            out.display()
+        ))
+    })
+}
+
+fn write_out(out: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliError> {
+    let path = out.join(name);
+    std::fs::write(&path, bytes)
+        .map_err(|e| CliError::failure(format!("{}: cannot write: {e}", path.display())))?;
+    Ok(path)
+}
+
+fn threads(args: &EvaluateArgs) -> Result<usize, CliError> {
+    match args.jobs {
+        Some(0) => Err(CliError::input(
+            "--jobs 0: give at least one thread, e.g. --jobs 2",
+        )),
+        Some(n) => Ok(n),
+        None => Ok(std::thread::available_parallelism().map_or(1, std::num::NonZeroUsize::get)),
+    }
+}
+
+/// `evaluate --recordings`: every record of the manifests through both paths.
+fn run_recordings(args: &EvaluateArgs) -> Result<(), CliError> {
+    let manifests = args
+        .recordings
+        .iter()
+        .map(|path| Manifest::read(path).map_err(CliError::input))
+        .collect::<Result<Vec<_>, _>>()?;
+    create_out(&args.out)?;
+    let options = RecordingsOptions {
+        all_channels: args.all_channels,
+        jobs: threads(args)?,
+        scratch: args.out.clone(),
+    };
+    let tasks = plan(&manifests, options.all_channels);
+    eprintln!(
+        "evaluate: {} records of {} manifest(s), {} record·channel runs{}, {} threads",
+        manifests.iter().map(|m| m.records.len()).sum::<usize>(),
+        manifests.len(),
+        tasks.len(),
+        if args.all_channels {
+            " (all channels)"
+        } else {
+            ""
+        },
+        options.jobs
+    );
+    let started = Instant::now();
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(tasks.len() as u64);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "evaluate {bar:20} {pos}/{len} ({eta}) {wide_msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    let progress = |done: usize, total: usize, entry: &Entry| {
+        let said = |path| Said::of(path, entry).name();
+        let line = format!(
+            "{}: analyze {}, daemon {}",
+            entry.label(),
+            said(JudgedPath::Record),
+            said(JudgedPath::Monitor)
+        );
+        match &bar {
+            Some(bar) => {
+                bar.set_position(done as u64);
+                bar.set_message(line);
+            }
+            None => eprintln!("evaluate: {done}/{total} {line}"),
+        }
+    };
+    let entries = evaluate_recordings(&tasks, &options, &progress);
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let counted = tally(&entries);
+    let table = render_recordings(&counted);
+    print!("{table}");
+    let json = RecordingsReport {
+        manifests: &args.recordings,
+        all_channels: args.all_channels,
+        summary: &counted,
+        entries: &entries,
+    }
+    .json()
+    .map_err(|e| CliError::failure(format!("cannot encode the results as JSON: {e}")))?;
+    let written = [
+        write_out(&args.out, "recordings.json", &json)?,
+        write_out(&args.out, "recordings.txt", table.as_bytes())?,
+    ];
+    eprintln!(
+        "evaluate: {} record·channel runs in {:.1} s; wrote {} and {}",
+        entries.len(),
+        started.elapsed().as_secs_f64(),
+        display(&written[0]),
+        display(&written[1])
+    );
+    if args.strict && counted.problems() > 0 {
+        return Err(CliError::failure(format!(
+            "--strict: {} confident-wrong answer(s) (analyze {}, daemon {}), {} disagreement(s), \
+             {} failed record(s)",
+            counted.record.confident_wrong + counted.daemon.confident_wrong,
+            counted.record.confident_wrong,
+            counted.daemon.confident_wrong,
+            counted.disagreements.len(),
+            counted.failures.len()
+        )));
+    }
+    Ok(())
 }

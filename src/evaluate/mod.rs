@@ -14,11 +14,15 @@
 //! - [`run`]: one case through both paths.
 //! - [`summary`]: Pd tables, false-alarm rates, confusion matrices, CSV.
 //! - [`figure`]: Pd vs SNR per fault type.
+//! - [`recordings`]: real recordings of a manifest through `analyze` and through the daemon
+//!   (`bearingd import` + `bearingd replay`, in-process), with the truth the manifest states
+//!   (`bearingd evaluate --recordings`).
 //!
 //! Deterministic: a case's result depends only on the sweep seed and the case, never on the
 //! thread that ran it or the order; results are kept in case order.
 
 pub mod figure;
+pub mod recordings;
 pub mod run;
 pub mod summary;
 pub mod sweep;
@@ -41,23 +45,41 @@ pub fn run_sweep(
     progress: &(dyn Fn(usize, usize) + Sync),
 ) -> Vec<CaseResult> {
     let cases = sweep.cases();
-    let total = cases.len();
+    in_order(
+        &cases,
+        threads,
+        RecordAnalyzer::default,
+        |analyzer, case| run_case(bench, sweep, case, analyzer),
+        &|done, total, _| progress(done, total),
+    )
+}
+
+/// `work` on every item on `threads` threads, each thread with its own `state` (an analyzer's
+/// buffers); `progress(done, total, result)` after each item (from the worker threads). The
+/// results come back in the items' order, whichever thread ran each.
+pub fn in_order<T: Sync, S, R: Send>(
+    items: &[T],
+    threads: usize,
+    state: impl Fn() -> S + Sync,
+    work: impl Fn(&mut S, &T) -> R + Sync,
+    progress: &(dyn Fn(usize, usize, &R) + Sync),
+) -> Vec<R> {
+    let total = items.len();
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
-    // One slot per case, filled by whichever thread ran it: the output order is the cases'.
-    let slots: Mutex<Vec<Option<CaseResult>>> = Mutex::new(vec![None; total]);
+    let slots: Mutex<Vec<Option<R>>> = Mutex::new((0..total).map(|_| None).collect());
     std::thread::scope(|scope| {
         for _ in 0..threads.clamp(1, total.max(1)) {
             scope.spawn(|| {
-                let mut analyzer = RecordAnalyzer::default();
+                let mut state = state();
                 loop {
                     let index = next.fetch_add(1, Ordering::Relaxed);
-                    let Some(case) = cases.get(index) else {
+                    let Some(item) = items.get(index) else {
                         break;
                     };
-                    let result = run_case(bench, sweep, case, &mut analyzer);
+                    let result = work(&mut state, item);
+                    progress(done.fetch_add(1, Ordering::Relaxed) + 1, total, &result);
                     slots.lock().unwrap_or_else(|e| e.into_inner())[index] = Some(result);
-                    progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
                 }
             });
         }

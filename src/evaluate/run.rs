@@ -51,6 +51,24 @@ impl Predicted {
         Predicted::Several,
     ];
 
+    /// What the flags say, from the highest level each fault's flag reached (outer, inner,
+    /// ball, cage): the one fault whose flag rose, none, the two of a verdict that cannot tell
+    /// them apart (a rolling element or the cage: ambiguous, as that verdict), or several.
+    pub fn of_flags(highest: [FlagLevel; 4]) -> Self {
+        let raised: Vec<FaultKind> = FaultKind::ALL
+            .into_iter()
+            .zip(highest)
+            .filter(|(_, level)| *level > FlagLevel::Ok)
+            .map(|(kind, _)| kind)
+            .collect();
+        match raised.as_slice() {
+            [] => Predicted::None,
+            [kind] => Predicted::Fault(*kind),
+            both if both == Verdict::BallOrCage.faults() => Predicted::Ambiguous,
+            _ => Predicted::Several,
+        }
+    }
+
     /// What a verdict says. Written against the verdict's public meaning (`fault()` names one
     /// fault or none), so that a verdict added later for "both named, not separable" counts as
     /// ambiguous without a change here.
@@ -70,6 +88,8 @@ pub struct RecordOutcome {
     pub predicted: Predicted,
     pub confidence: f64,
     pub reason: String,
+    /// With a `none` verdict: the faults detected but not told apart.
+    pub candidates: Vec<FaultKind>,
     /// Fault scores in outer, inner, ball, cage order.
     pub scores: [f64; 4],
 }
@@ -286,7 +306,8 @@ pub fn run_case(
     }
 }
 
-fn record_outcome(
+/// What the record path concluded, from its analysis.
+pub fn record_outcome(
     diagnosis: &Diagnosis,
     analysis: &crate::analysis::RecordAnalysis,
 ) -> RecordOutcome {
@@ -295,6 +316,7 @@ fn record_outcome(
         predicted: Predicted::of_verdict(diagnosis.verdict),
         confidence: diagnosis.confidence,
         reason: diagnosis.reason.clone(),
+        candidates: diagnosis.candidates.clone(),
         scores: FaultKind::ALL.map(|kind| analysis.score(kind)),
     }
 }
@@ -336,22 +358,11 @@ fn run_monitor(
     }
     // The record's end, as a replay's: the last verdict on what was not analysed yet.
     monitor.finish(&mut watch);
-    let raised: Vec<FaultKind> = FaultKind::ALL
-        .into_iter()
-        .zip(highest)
-        .filter(|(_, l)| *l > FlagLevel::Ok)
-        .map(|(k, _)| k)
-        .collect();
-    let predicted = match raised.as_slice() {
-        [] => Predicted::None,
-        [one] => Predicted::Fault(*one),
-        _ => Predicted::Several,
-    };
     MonitorOutcome {
         highest,
         first_flag_s: first_flag,
         windows_scored: scored,
         windows_flagged: flagged,
-        predicted,
+        predicted: Predicted::of_flags(highest),
     }
 }

@@ -257,38 +257,54 @@ pub fn render_tables(summary: &Summary) -> String {
                 String::new()
             }
         );
-        // Confusion matrix: only the columns this path can produce, plus any that occurred.
-        let columns: Vec<Predicted> = Predicted::COLUMNS
-            .into_iter()
-            .filter(|c| {
-                let possible = !matches!(
-                    (p.path, c),
-                    (Path::Record, Predicted::Several) | (Path::Monitor, Predicted::Ambiguous)
-                );
-                possible
-                    || p.confusion
-                        .values()
-                        .any(|row| row.get(c.name()).is_some_and(|&n| n > 0))
-            })
-            .collect();
-        let _ = write!(out, "{:<12}", "true\\said");
-        for c in &columns {
-            let _ = write!(out, "{:>11}", c.name());
-        }
-        let _ = writeln!(out);
-        for name in condition_names() {
-            let Some(row) = p.confusion.get(name) else {
-                continue;
-            };
-            let _ = write!(out, "{name:<12}");
-            for c in &columns {
-                let _ = write!(out, "{:>11}", row.get(c.name()).copied().unwrap_or(0));
-            }
-            let _ = writeln!(out);
-        }
+        render_confusion(&mut out, p.path, &p.confusion, &condition_names(), &[]);
         let _ = writeln!(out);
     }
     out
+}
+
+/// A confusion matrix as a text table: `rows` in order (those present), the columns of
+/// [`Predicted::COLUMNS`] this path can produce, any other that occurred, then those of
+/// `extra_columns` that occurred.
+pub fn render_confusion(
+    out: &mut String,
+    path: Path,
+    confusion: &BTreeMap<String, BTreeMap<String, u64>>,
+    rows: &[&str],
+    extra_columns: &[&'static str],
+) {
+    let occurred = |column: &str| {
+        confusion
+            .values()
+            .any(|row| row.get(column).is_some_and(|&n| n > 0))
+    };
+    let columns: Vec<&'static str> = Predicted::COLUMNS
+        .into_iter()
+        .filter(|c| {
+            let possible = !matches!(
+                (path, c),
+                (Path::Record, Predicted::Several) | (Path::Monitor, Predicted::Ambiguous)
+            );
+            possible || occurred(c.name())
+        })
+        .map(Predicted::name)
+        .chain(extra_columns.iter().copied().filter(|c| occurred(c)))
+        .collect();
+    let _ = write!(out, "{:<12}", "true\\said");
+    for c in &columns {
+        let _ = write!(out, "{c:>11}");
+    }
+    let _ = writeln!(out);
+    for &name in rows {
+        let Some(row) = confusion.get(name) else {
+            continue;
+        };
+        let _ = write!(out, "{name:<12}");
+        for c in &columns {
+            let _ = write!(out, "{:>11}", row.get(*c).copied().unwrap_or(0));
+        }
+        let _ = writeln!(out);
+    }
 }
 
 /// One line per case, for a spreadsheet.

@@ -8,6 +8,7 @@ mod daemon;
 mod dataset;
 mod developer_set;
 mod envelope;
+mod evaluate_recordings;
 mod fleet;
 mod formats;
 mod kinematics;

@@ -7,9 +7,11 @@
 //! note for each retention deletion, and pauses logging when a write fails (a full disk)
 //! without stopping the pipeline, resuming when the directory has room ([`LogNotice`]). The
 //! format itself (schemas, topics, file names, reading back) is [`crate::mcap_log`]; what each
-//! file says about itself in MCAP metadata records is [`metadata`].
+//! file says about itself in MCAP metadata records is [`metadata`]; a recording written as
+//! such a log (`import`, `dataset`, `evaluate --recordings`) is [`raw_log`].
 
 pub mod metadata;
+pub mod raw_log;
 pub mod recover;
 pub mod writer;
 
