@@ -356,9 +356,7 @@ pub fn analyze_recording(
         );
         let fit_ms = started.elapsed().as_secs_f64() * 1e3;
         let (combined, agrees, note) = combine(&analysis.diagnosis, &twin);
-        report.confidence = combined.confidence;
-        report.reason = combined.reason;
-        report.twin = Some(TwinReport::new(&twin, fit_ms, agrees, note));
+        report.set_twin(TwinReport::new(&twin, fit_ms, agrees, note), &combined);
         twin
     });
     if let Some(model) = &request.learned {

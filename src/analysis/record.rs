@@ -65,6 +65,12 @@ pub struct RecordAnalysis {
     /// The band the selection method (kurtogram, GK or fixed) chose.
     pub selected_band_index: usize,
     pub hypotheses: Vec<Hypothesis>,
+    /// The hypothesis that led the contest (the others were weighed with its comb explained
+    /// away); `None` when nothing was scored.
+    pub leader: Option<FaultKind>,
+    /// The other hypotheses re-scored with the leader's comb explained away: what the verdict
+    /// weighed them on.
+    pub explained: Vec<FaultScore>,
     pub diagnosis: Diagnosis,
     /// The band behind the verdict: the diagnosed fault's band, else the selected band.
     pub reported_band_index: usize,
@@ -264,6 +270,7 @@ pub fn analyze_with_plans(
             .map(|&kind| best_band(&mut scorer, kind, None))
             .collect();
         let scores: Vec<FaultScore> = hypotheses.iter().map(|h| h.score).collect();
+        let leader_kind = leader(&scores, &rule).map(|l| l.fault);
         let explained: Vec<FaultScore> = match leader(&scores, &rule) {
             Some(leader) => FaultKind::ALL
                 .iter()
@@ -288,6 +295,8 @@ pub fn analyze_with_plans(
             scan,
             selected_band_index,
             hypotheses,
+            leader: leader_kind,
+            explained,
             diagnosis,
             reported_band_index,
         })

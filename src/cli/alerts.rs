@@ -10,9 +10,11 @@ use super::CliError;
 use crate::clock::wall_clock_now_ns;
 use crate::config;
 use crate::iox::IoxSettings;
+use crate::messages::{FaultKind, FlagLevel};
+use crate::report::plain::flag_words;
 use crate::sinks::alerts::payload::AlertDecodeError;
 use crate::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
-use crate::sinks::alerts::{Alert, AlertState};
+use crate::sinks::alerts::{Alert, AlertState, AlertView};
 use clap::Args;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -214,6 +216,20 @@ fn act_as_daemon_user(settings: &AlertServiceSettings) -> Result<(), CliError> {
     Ok(())
 }
 
+/// What a bearing fault's alert means for the technician (`None` for the velocity zone's,
+/// whose line already says it in ISO terms).
+fn plain_words(view: &AlertView) -> Option<String> {
+    let fault = FaultKind::ALL
+        .into_iter()
+        .find(|k| k.name() == view.fault)?;
+    let level = |name: &str| FlagLevel::ALL.into_iter().find(|l| l.name() == name);
+    Some(flag_words(
+        fault,
+        level(view.previous_severity)?,
+        level(view.severity)?,
+    ))
+}
+
 struct Printer {
     json: bool,
     printed: u64,
@@ -240,7 +256,10 @@ impl Printer {
             println!("{value}");
         } else {
             let prefix = if active_at_start { "ACTIVE" } else { "ALERT " };
-            println!("{prefix} {}", view.line());
+            match plain_words(&view) {
+                Some(words) => println!("{prefix} {} — {words}", view.line()),
+                None => println!("{prefix} {}", view.line()),
+            }
         }
     }
 

@@ -282,10 +282,7 @@ fn print_json(
 
 fn print_text(summary: &ReplaySummary, out: &Path) {
     for flag in &summary.flags {
-        println!(
-            "flag {}: {} {} -> {} at sample {} (score {:.1})",
-            flag.channel, flag.fault, flag.from, flag.to, flag.end_sample, flag.score
-        );
+        println!("{}", super::run::flag_recap(flag));
     }
     println!(
         "replayed {} blocks, {} samples ({:.1} s of signal) in {} run(s) in {:.2} s ({:.0}× real time); output in {}",

@@ -6,8 +6,9 @@ use crate::config::{self, Config};
 use crate::daemon::state::StateError;
 use crate::daemon::{run, DaemonEvent, Events, RunOptions};
 use crate::mcap_log::files::utc_text;
-use crate::messages::{HealthKind, PipelineMessage, SpeedSource};
+use crate::messages::{FlagMessage, HealthKind, PipelineMessage, SpeedSource};
 use crate::pipeline::{ChannelStatus, Sink, SinkError};
+use crate::report::plain::flag_words;
 use crate::sinks::mcap::{LogNotice, RecoveryAction, RecoveryReport};
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -45,8 +46,15 @@ impl Sink for FlagPrinter {
     fn write(&mut self, message: &PipelineMessage) {
         match message {
             PipelineMessage::Flag(f) => println!(
-                "FLAG {}: {} {} -> {} (score {:.1}, {:.1} Hz) at sample {}",
-                f.channel, f.fault, f.from, f.to, f.score, f.fault_frequency_hz, f.end_sample
+                "FLAG {}: {} {} -> {} — {} (score {:.1}, {:.1} Hz) at sample {}",
+                f.channel,
+                f.fault,
+                f.from,
+                f.to,
+                flag_words(f.fault, f.from, f.to),
+                f.score,
+                f.fault_frequency_hz,
+                f.end_sample
             ),
             PipelineMessage::VelocityFlag(f) => println!(
                 "FLAG {}: {} {} -> {} (ISO velocity {:.2} mm/s, zone {}; C from {}, D from {} mm/s) at sample {}",
@@ -154,12 +162,23 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         println!("  {}", status_line(channel));
     }
     for flag in &summary.flags {
-        println!(
-            "  flag {}: {} {} -> {} at sample {} (score {:.1})",
-            flag.channel, flag.fault, flag.from, flag.to, flag.end_sample, flag.score
-        );
+        println!("  {}", flag_recap(flag));
     }
     Ok(())
+}
+
+/// One flag change of a run's or a replay's summary, with what it means for the technician.
+pub(super) fn flag_recap(flag: &FlagMessage) -> String {
+    format!(
+        "flag {}: {} {} -> {} — {} at sample {} (score {:.1})",
+        flag.channel,
+        flag.fault,
+        flag.from,
+        flag.to,
+        flag_words(flag.fault, flag.from, flag.to),
+        flag.end_sample,
+        flag.score
+    )
 }
 
 fn embedded_default(args: &RunArgs) -> Result<Config, CliError> {

@@ -4,6 +4,7 @@
 
 mod figure;
 mod life;
+pub mod plain;
 mod text;
 
 pub use figure::analysis_figure;
@@ -12,6 +13,7 @@ pub use life::{
 };
 pub use text::render_text;
 
+use crate::analysis::diagnosis::{DecisionRule, Diagnosis, Verdict};
 use crate::analysis::fault_bands::HarmonicPeak;
 use crate::analysis::indicators::Indicators;
 use crate::analysis::iso::VelocitySeverity;
@@ -90,6 +92,22 @@ pub struct HypothesisReport {
     pub slip: f64,
     pub sideband_score: Option<f64>,
     pub harmonics: Vec<HarmonicPeak>,
+    /// What is left of it once the leading hypothesis's comb is explained away (`null` for the
+    /// leader itself): what the verdict weighed it on.
+    pub explained: Option<ExplainedScore>,
+    /// Whether the verdict names this fault.
+    pub named: bool,
+    /// When not named: why, in a few plain words (see [`plain::why_not`]).
+    pub why_not: Option<String>,
+}
+
+/// A hypothesis re-scored with the leader's comb explained away.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ExplainedScore {
+    /// The leading hypothesis.
+    pub by: FaultKind,
+    pub score: f64,
+    pub significance: f64,
 }
 
 /// The JSON document of `bearingd analyze --format json`.
@@ -110,7 +128,14 @@ pub struct AnalyzeReport {
     pub band_selection: BandSelectionReport,
     pub fault_frequencies_hz: FaultFrequenciesHz,
     pub scores: Scores,
+    /// The verdict in a technician's words: what is wrong, how sure, what to do
+    /// ([`plain::summary`]); worded again by the methods that change the verdict or its
+    /// confidence (`set_twin`, `set_learned`).
+    pub summary: String,
     pub diagnosis: &'static str,
+    /// `diagnosis` as the type the plain words are chosen by.
+    #[serde(skip)]
+    pub verdict: Verdict,
     pub confidence: f64,
     pub reason: String,
     /// With `none`: the faults that were each detected but could not be told apart.
@@ -204,15 +229,38 @@ pub struct Thresholds {
     pub harmonics: usize,
 }
 
+impl Thresholds {
+    /// The decision rule these thresholds make up.
+    pub fn rule(&self) -> DecisionRule {
+        DecisionRule {
+            false_alarm_rate: self.false_alarm_rate,
+            min_fault_score: self.min_fault_score,
+            min_score_ratio: self.min_score_ratio,
+            lone_fault_score: self.lone_fault_score,
+            lone_score_ratio: self.lone_score_ratio,
+        }
+    }
+}
+
 fn band_pair(band: crate::analysis::Band) -> [f64; 2] {
     [band.lo_hz, band.hi_hz]
 }
 
 impl AnalyzeReport {
+    /// Adds the twin's fit; its confidence and reason become the combined ones (see
+    /// [`crate::twin::diagnose::combine`]).
+    pub fn set_twin(&mut self, twin: TwinReport, combined: &Diagnosis) {
+        self.confidence = combined.confidence;
+        self.reason = combined.reason.clone();
+        self.twin = Some(twin);
+        self.settle_plain();
+    }
+
     /// Adds the learned opinion; the diagnosis becomes the combined one.
     pub fn set_learned(&mut self, opinion: LearnedOpinion, combined: Combined) {
         let envelope_diagnosis = self.diagnosis;
         self.diagnosis = combined.verdict.name();
+        self.verdict = combined.verdict;
         if combined.basis == Basis::EnvelopeConfirmedByLearned {
             self.reason = combined.reason;
             self.candidates.clear();
@@ -225,6 +273,47 @@ impl AnalyzeReport {
             basis: combined.basis,
             learned_agrees: combined.learned_agrees,
         });
+        self.settle_plain();
+    }
+
+    /// The structured fields the plain words are made from.
+    pub fn plain_facts(&self) -> plain::Facts<'_> {
+        plain::Facts {
+            verdict: self.verdict,
+            confidence: self.confidence,
+            candidates: &self.candidates,
+            hypotheses: &self.hypotheses,
+            rule: self.thresholds.rule(),
+            learned: self
+                .learned
+                .as_ref()
+                .filter(|l| l.opinion.segments > 0)
+                .map(|l| plain::LearnedFacts {
+                    basis: l.basis,
+                    agrees: l.learned_agrees,
+                }),
+            twin_prefers: self
+                .twin
+                .as_ref()
+                .filter(|t| !t.agrees_with_scores)
+                .map(|t| t.hypothesis),
+        }
+    }
+
+    /// Words the verdict and each fault's part in it again, after anything that changes them.
+    fn settle_plain(&mut self) {
+        let facts = self.plain_facts();
+        let summary = plain::summary(&facts);
+        let why: Vec<Option<String>> = self
+            .hypotheses
+            .iter()
+            .map(|h| plain::why_not(&facts, h))
+            .collect();
+        self.summary = summary;
+        for (h, why_not) in self.hypotheses.iter_mut().zip(why) {
+            h.named = why_not.is_none();
+            h.why_not = why_not;
+        }
     }
 
     pub fn new(
@@ -253,7 +342,16 @@ impl AnalyzeReport {
             ),
             _ => format!("chosen by {method_words}"),
         };
-        AnalyzeReport {
+        let explained = |kind: FaultKind| {
+            let by = analysis.leader?;
+            let s = analysis.explained.iter().find(|s| s.fault == kind)?;
+            Some(ExplainedScore {
+                by,
+                score: s.score,
+                significance: s.significance,
+            })
+        };
+        let mut report = AnalyzeReport {
             file: context.file.clone(),
             channel: context.channel.clone(),
             fs_hz: analysis.fs_hz,
@@ -285,7 +383,9 @@ impl AnalyzeReport {
                 ball: analysis.score(FaultKind::Ball),
                 cage: analysis.score(FaultKind::Cage),
             },
+            summary: String::new(),
             diagnosis: analysis.diagnosis.verdict.name(),
+            verdict: analysis.diagnosis.verdict,
             confidence: analysis.diagnosis.confidence,
             reason: analysis.diagnosis.reason.clone(),
             candidates: analysis.diagnosis.candidates.clone(),
@@ -311,12 +411,17 @@ impl AnalyzeReport {
                     slip: h.score.slip,
                     sideband_score: h.score.sideband_score,
                     harmonics: h.score.peaks().to_vec(),
+                    explained: explained(h.score.fault),
+                    named: false,
+                    why_not: None,
                 })
                 .collect(),
             velocity: None,
             twin: None,
             learned: None,
             warnings: context.warnings.clone(),
-        }
+        };
+        report.settle_plain();
+        report
     }
 }

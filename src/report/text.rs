@@ -1,4 +1,5 @@
-//! The text summary of `bearingd analyze`: what a maintenance engineer reads first.
+//! The text summary of `bearingd analyze`: the verdict in plain words first (for the
+//! technician, [`super::plain`]), then the evidence for the engineer.
 
 use super::{AnalyzeReport, SpeedSource};
 use std::fmt::Write;
@@ -6,6 +7,7 @@ use std::fmt::Write;
 /// Renders the report as a few aligned lines of text.
 pub fn render_text(r: &AnalyzeReport) -> String {
     let mut out = String::new();
+    let _ = writeln!(out, "VERDICT: {}", r.summary);
     let speed_from = match r.rpm_source {
         SpeedSource::File => "from the file",
         SpeedSource::Given => "given",
@@ -39,7 +41,7 @@ pub fn render_text(r: &AnalyzeReport) -> String {
     );
     let _ = writeln!(
         out,
-        "  fault scores (comb peak/floor over {} harmonics and their sidebands, ±{:.0} % slip; a fault needs p ≤ {:.0e} against noise, ≥ {:.1}, and {:.1}× any other detected fault once explained; or, alone, ≥ {:.1} and {:.1}× every other):",
+        "  how far each fault's frequencies stand above the noise floor (×; {} harmonics and their sidebands, ±{:.0} % slip), how likely noise alone gives that (p), and whether it is named (it needs p ≤ {:.0e}, ≥ {:.1}×, and {:.1}× any other detected fault once the strongest is explained; or, alone, ≥ {:.1}× and {:.1}× every other):",
         r.thresholds.harmonics,
         r.thresholds.fault_tolerance * 100.0,
         r.thresholds.false_alarm_rate,
@@ -54,9 +56,13 @@ pub fn render_text(r: &AnalyzeReport) -> String {
             .sideband_score
             .map(|s| format!("  sidebands {s:.1}"))
             .unwrap_or_default();
+        let named = match &h.why_not {
+            None => "named".to_string(),
+            Some(why) => format!("not named: {why}"),
+        };
         let _ = writeln!(
             out,
-            "    {:<11} {:>7.1}  p=10^-{:<5.1} {:<40} in {:.0}–{:.0} Hz{}",
+            "    {:<11} {:>7.1}  p=10^-{:<5.1} {:<40} in {:.0}–{:.0} Hz{}  {named}",
             h.fault.name(),
             h.score,
             h.significance,

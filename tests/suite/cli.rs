@@ -69,6 +69,54 @@ fn demo_json_has_every_documented_key_and_finds_the_simulated_fault() {
     assert_eq!(json["diagnosis"], "outer_race");
 }
 
+/// The text report opens with the verdict in a technician's words (what, how sure, what to do;
+/// no statistics), and the per-fault list marks each fault named or says why not; the JSON
+/// carries the same line and marks.
+#[test]
+fn analyze_opens_with_the_plain_verdict_and_says_why_a_fault_is_not_named() {
+    let Some(dir) = shared_data_dir("cwru") else {
+        return;
+    };
+    for (file, opening, named) in [
+        (
+            "12k_Drive_End_OR007@6_0_130.mat",
+            "VERDICT: Outer race defect, clear (",
+            Some("outer_race"),
+        ),
+        ("normal_0_97.mat", "VERDICT: No bearing fault found", None),
+    ] {
+        let path = dir.join(file);
+        let path = path.to_str().unwrap();
+        let out = bearingd(&["analyze", path]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = String::from_utf8_lossy(&out.stdout);
+        let first = text.lines().next().unwrap_or_default();
+        assert!(first.starts_with(opening), "{file}: {text}");
+        for jargon in ["p=", "10^", "comb", "GK", "_race"] {
+            assert!(!first.contains(jargon), "{file}: '{jargon}' in {first}");
+        }
+        let marks: Vec<&str> = text
+            .lines()
+            .filter(|l| l.ends_with("  named") || l.contains("  not named: "))
+            .collect();
+        assert_eq!(marks.len(), 4, "{file}: one mark per fault:\n{text}");
+
+        let out = bearingd(&["analyze", path, "--format", "json"]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(
+            format!("VERDICT: {}", json["summary"].as_str().unwrap()),
+            first,
+            "{file}"
+        );
+        for h in json["hypotheses"].as_array().unwrap() {
+            let is_named = named == h["fault"].as_str();
+            assert_eq!(h["named"], is_named, "{file}: {h}");
+            assert_eq!(h["why_not"].is_string(), !is_named, "{file}: {h}");
+        }
+    }
+}
+
 #[test]
 fn plots_are_written_as_png_and_svg() {
     let dir = scratch_dir("cli-plot");
