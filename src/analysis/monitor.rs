@@ -199,7 +199,7 @@ pub enum MonitorEvent<'a> {
         at_sample: u64,
         bands: [Band; 4],
         selected: Band,
-        evidence: Option<Evidence>,
+        evidence: Option<&'a Evidence>,
         evidence_from: u64,
     },
     /// A velocity reading ([`super::iso`]) and the zone flag's level after it.
@@ -754,7 +754,7 @@ impl ChannelMonitor {
             at_sample: self.next_sample,
             bands,
             selected,
-            evidence,
+            evidence: evidence.as_ref(),
             evidence_from: self.band_job_from,
         });
         if let Some(evidence) = evidence {

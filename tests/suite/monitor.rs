@@ -186,7 +186,7 @@ fn a_flag_follows_the_verdict_of_its_evidence_and_carries_its_runner_up() {
             evidence: Some(evidence),
             ..
         } => {
-            verdicts.insert(at_sample, evidence);
+            verdicts.insert(at_sample, *evidence);
         }
         MonitorEvent::Flag {
             fault,
