@@ -643,8 +643,10 @@ fn issue11_a_full_disk_pauses_the_log_keeps_analysing_and_resumes_when_there_is_
         f.sync_all().unwrap();
     }
     let root = format!("/dev/shm/bearingd-faults-full-{}", std::process::id());
+    // The fault from 20 s: the band selection at 32 s (its 10 s of evidence all faulty) names
+    // it, well after the log has filled the disk (within the first seconds).
     let config = config_file(&dir, |text| {
-        text.replace("onset_s = 30.0", "onset_s = 5.0")
+        text.replace("onset_s = 30.0", "onset_s = 20.0")
             .replace("\"/run/bearingd/iceoryx2\"", &format!("\"{root}\""))
     });
     let started = Instant::now();

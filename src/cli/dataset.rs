@@ -8,7 +8,7 @@
 use super::import::raw_log_error;
 use super::CliError;
 use crate::bearing::BearingGeometry;
-use crate::sinks::mcap::raw_log::{write_raw_log, RawLog};
+use crate::sinks::mcap::raw_log::{write_raw_log, LogSignal, RawLog};
 use crate::twin::dataset::{DatasetRecord, DatasetSpec};
 use clap::Args;
 use ndarray::{Array1, Array2};
@@ -195,12 +195,14 @@ fn write_logs(
         .try_for_each(|(record, samples)| {
             let samples: Vec<f64> = samples.iter().map(|&x| f64::from(x)).collect();
             write_raw_log(&RawLog {
-                out: &out.join(log_dir(record)),
-                sensor: "dataset",
-                samples: &samples,
-                fs_hz: spec.fs_hz,
-                rpm: record.rpm,
-                bearing: &bearing,
+                signal: LogSignal {
+                    out: &out.join(log_dir(record)),
+                    sensor: "dataset",
+                    samples: &samples,
+                    fs_hz: spec.fs_hz,
+                    rpm: record.rpm,
+                    bearing: &bearing,
+                },
                 origin_ns,
                 about: (
                     "bearingd.dataset".to_string(),

@@ -7,7 +7,7 @@
 use super::{CliError, RecordingArgs};
 use crate::offline::{resolve_conditions, AnalyzeRequest};
 use crate::recording::read_recording;
-use crate::sinks::mcap::raw_log::{import_recording, Import, RawLogError};
+use crate::sinks::mcap::raw_log::{import_recording, Import, LogSignal, RawLogError};
 use clap::Args;
 use std::path::PathBuf;
 
@@ -41,12 +41,14 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     let fs = conditions.fs_hz;
     let imported = import_recording(&Import {
         file: &args.file,
-        out: &args.out,
-        sensor: &args.sensor,
-        samples: &recording.samples,
-        fs_hz: fs,
-        rpm: conditions.rpm,
-        bearing: &conditions.bearing,
+        signal: LogSignal {
+            out: &args.out,
+            sensor: &args.sensor,
+            samples: &recording.samples,
+            fs_hz: fs,
+            rpm: conditions.rpm,
+            bearing: &conditions.bearing,
+        },
     })
     .map_err(raw_log_error)?;
     let (written, origin_ns, time_source) =

@@ -266,6 +266,20 @@ impl Channel {
         spectrum_every_s: f64,
         out: &mut impl FnMut(Output),
     ) {
+        self.drive(id, spectrum_every_s, out, |monitor, mut on_event| {
+            monitor.set_speed_at(at_sample, rpm.map(|r| r / 60.0), &mut on_event)
+        });
+    }
+
+    /// Runs `step` on the channel's monitor with its events turned into the pipeline's outputs,
+    /// then takes the flags into the channel's status.
+    fn drive(
+        &mut self,
+        id: &ChannelId,
+        spectrum_every_s: f64,
+        out: &mut impl FnMut(Output),
+        step: impl FnOnce(&mut ChannelMonitor, &mut dyn FnMut(MonitorEvent)),
+    ) {
         let fs = self.fs_hz;
         let Channel {
             monitor,
@@ -273,7 +287,7 @@ impl Channel {
             next_spectrum,
             ..
         } = self;
-        monitor.set_speed_at(at_sample, rpm.map(|r| r / 60.0), &mut |event| {
+        step(monitor, &mut |event| {
             handle_event(id, fs, spectrum_every_s, next_spectrum, status, event, out)
         });
         self.status.flags = self.monitor.flag_levels();
@@ -412,24 +426,10 @@ impl Pipeline {
                     scale_g_per_count,
                     counts: counts.iter().map(|&c| i32::from(c)).collect(),
                 })));
-                let fs = c.fs_hz;
-                let Channel {
-                    monitor,
-                    status,
-                    next_spectrum,
-                    ..
-                } = c;
-                monitor.push_counts(first_sample, &counts, scale_g_per_count, &mut |event| {
-                    handle_event(
-                        &channel,
-                        fs,
-                        spectrum_every_s,
-                        next_spectrum,
-                        status,
-                        event,
-                        out,
-                    )
+                c.drive(&channel, spectrum_every_s, out, |monitor, mut on_event| {
+                    monitor.push_counts(first_sample, &counts, scale_g_per_count, &mut on_event)
                 });
+                let fs = c.fs_hz;
                 c.status.samples = c.monitor.next_sample();
                 c.status.seconds = c.status.samples as f64 / fs;
                 c.status.flags = c.monitor.flag_levels();
@@ -505,17 +505,9 @@ impl Pipeline {
     pub fn finish(&mut self, out: &mut impl FnMut(Output)) {
         let spectrum_every_s = self.spectrum_every_s;
         for (id, c) in &mut self.channels {
-            let fs = c.fs_hz;
-            let Channel {
-                monitor,
-                status,
-                next_spectrum,
-                ..
-            } = c;
-            monitor.finish(&mut |event| {
-                handle_event(id, fs, spectrum_every_s, next_spectrum, status, event, out)
+            c.drive(id, spectrum_every_s, out, |monitor, mut on_event| {
+                monitor.finish(&mut on_event)
             });
-            c.status.flags = c.monitor.flag_levels();
         }
     }
 

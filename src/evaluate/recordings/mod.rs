@@ -47,7 +47,7 @@ use crate::recording::{
     detect_format, list_channels, read_recording, ReadOptions, RecordingFormat,
 };
 use crate::report::SpeedSource;
-use crate::sinks::mcap::raw_log::{import_recording, Import};
+use crate::sinks::mcap::raw_log::{import_recording, Import, LogSignal};
 use crate::sources::replay::plan::{LoggedSettings, ReplayPlan};
 use serde::Serialize;
 use std::io::Read;
@@ -338,12 +338,14 @@ pub fn evaluate_task(task: &Task, scratch: &Path, analyzer: &mut RecordAnalyzer)
     };
     let daemon = match import_recording(&Import {
         file,
-        out: scratch,
-        sensor: "imported",
-        samples: &recording.samples,
-        fs_hz: conditions.fs_hz,
-        rpm: conditions.rpm,
-        bearing: &conditions.bearing,
+        signal: LogSignal {
+            out: scratch,
+            sensor: "imported",
+            samples: &recording.samples,
+            fs_hz: conditions.fs_hz,
+            rpm: conditions.rpm,
+            bearing: &conditions.bearing,
+        },
     }) {
         Ok(_) => replay_imported(scratch, conditions.fs_hz, seconds),
         Err(e) => DaemonOutcome::Failed {

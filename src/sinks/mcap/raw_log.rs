@@ -18,14 +18,21 @@ const FULL_SCALE_COUNTS: f64 = 30_000.0;
 /// Seconds of signal per raw block.
 const BLOCK_S: f64 = 0.1;
 
-/// A recording to write as a raw log.
-pub struct RawLog<'a> {
+/// The samples of a raw log, what they were taken under, and where the log goes.
+#[derive(Debug, Clone, Copy)]
+pub struct LogSignal<'a> {
+    /// The directory of the log and its `replay.toml`.
     pub out: &'a Path,
     pub sensor: &'a str,
     pub samples: &'a [f64],
     pub fs_hz: f64,
     pub rpm: f64,
     pub bearing: &'a BearingGeometry,
+}
+
+/// A recording to write as a raw log.
+pub struct RawLog<'a> {
+    pub signal: LogSignal<'a>,
     /// Wall-clock time of sample 0, ns since the epoch.
     pub origin_ns: u64,
     /// A metadata record saying where the recording came from.
@@ -63,16 +70,17 @@ pub enum RawLogError {
 /// (the settings to replay it with, short band period and delays since recordings are short),
 /// plus the same settings as `replay.toml`.
 pub fn write_raw_log(log: &RawLog) -> Result<WrittenLog, RawLogError> {
-    let (fs, rpm, b) = (log.fs_hz, log.rpm, log.bearing);
+    let signal = &log.signal;
+    let (fs, rpm, b) = (signal.fs_hz, signal.rpm, signal.bearing);
     let bearing_spec = b.spec();
-    let peak = log.samples.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let peak = signal.samples.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let scale = if peak > 0.0 {
         peak / FULL_SCALE_COUNTS
     } else {
         1e-6
     };
     let channel = ChannelId {
-        sensor: log.sensor.to_string(),
+        sensor: signal.sensor.to_string(),
         axis: "radial".into(),
     };
     let config_text = format!(
@@ -85,18 +93,18 @@ pub fn write_raw_log(log: &RawLog) -> Result<WrittenLog, RawLogError> {
          [analysis]\nband_period_s = {horizon}\nevidence_horizon_s = {horizon}\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 5.0\nbaseline_windows = 5\n\n\
          [outputs]\nstate_dir = \"{out}/state\"\nmcap_dir = \"{out}/replay\"\n",
         what = log.what,
-        horizon = evidence_horizon_s(log.samples.len(), fs),
-        out = log.out.display(),
-        sensor = log.sensor,
+        horizon = evidence_horizon_s(signal.samples.len(), fs),
+        out = signal.out.display(),
+        sensor = signal.sensor,
     );
-    let config_path = log.out.join("replay.toml");
+    let config_path = signal.out.join("replay.toml");
     let config = crate::config::parse(&config_text, &config_path.display().to_string())
         .map_err(RawLogError::Settings)?;
     let mut metadata = run_records(&config, log.origin_ns, log.origin_ns, &Default::default());
     metadata.push(log.about.clone());
     let logger_config = LoggerConfig {
         metadata,
-        ..LoggerConfig::new(log.out)
+        ..LoggerConfig::new(signal.out)
     };
     let mut logger = McapLogger::create(logger_config, log.origin_ns).map_err(RawLogError::Open)?;
     // The speed the record was taken at, stated in the log itself, so that `analyze` reads it
@@ -112,7 +120,7 @@ pub fn write_raw_log(log: &RawLog) -> Result<WrittenLog, RawLogError> {
         .log(&speed, log.origin_ns, log.origin_ns)
         .map_err(RawLogError::Write)?;
     let block = ((fs * BLOCK_S).round() as usize).max(1);
-    for (i, chunk) in log.samples.chunks(block).enumerate() {
+    for (i, chunk) in signal.samples.chunks(block).enumerate() {
         let first_sample = (i * block) as u64;
         let message = PipelineMessage::Raw(RawBlock {
             channel: channel.clone(),
@@ -143,12 +151,7 @@ pub fn write_raw_log(log: &RawLog) -> Result<WrittenLog, RawLogError> {
 /// and the conditions resolved for them.
 pub struct Import<'a> {
     pub file: &'a Path,
-    pub out: &'a Path,
-    pub sensor: &'a str,
-    pub samples: &'a [f64],
-    pub fs_hz: f64,
-    pub rpm: f64,
-    pub bearing: &'a BearingGeometry,
+    pub signal: LogSignal<'a>,
 }
 
 /// What [`import_recording`] wrote, and the date it gave the log.
@@ -165,12 +168,7 @@ pub struct Imported {
 pub fn import_recording(import: &Import) -> Result<Imported, RawLogError> {
     let (origin_ns, time_source) = recording_date(import.file);
     let written = write_raw_log(&RawLog {
-        out: import.out,
-        sensor: import.sensor,
-        samples: import.samples,
-        fs_hz: import.fs_hz,
-        rpm: import.rpm,
-        bearing: import.bearing,
+        signal: import.signal,
         origin_ns,
         about: (
             IMPORT_RECORD.to_string(),
