@@ -727,3 +727,127 @@ fn prominence(values: &[f64], i: usize) -> f64 {
     }
     height - left_base.max(right_base)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::twin::{SimulatedFault, SimulationParams, Simulator};
+
+    /// Two seconds of the signal model's race defect with entry and exit impacts `length_mm`
+    /// apart (0: one impact per passage), resonance 3 kHz.
+    fn signal_model(fault: SimulatedFault, fs_hz: f64, length_mm: f64) -> (Vec<f32>, f64) {
+        let mut params = SimulationParams::example(fault);
+        params.fs_hz = fs_hz;
+        params.defect_length_mm = length_mm;
+        params.noise_g = 0.1;
+        let rate = params.impact_rate_hz();
+        (Simulator::record(params, 2.0), rate)
+    }
+
+    fn size(
+        signal: &[f32],
+        fs_hz: f64,
+        fault: FaultKind,
+        rate: f64,
+    ) -> Result<DefectSize, NotMeasured> {
+        let bearing = BearingGeometry::from_catalog("skf-6205-2rs").unwrap();
+        measure_defect_size(
+            signal,
+            fs_hz,
+            fault,
+            rate,
+            Band::new(2_000.0, 4_000.0),
+            &bearing,
+        )
+    }
+
+    #[test]
+    fn sizes_the_entry_and_exit_the_signal_model_draws() {
+        let mut sized = 0;
+        for (fault, kind) in [
+            (SimulatedFault::OuterRace, FaultKind::OuterRace),
+            (SimulatedFault::InnerRace, FaultKind::InnerRace),
+        ] {
+            for length_mm in [0.5, 1.0, 2.0] {
+                let (signal, rate) = signal_model(fault, 48_000.0, length_mm);
+                match size(&signal, 48_000.0, kind, rate) {
+                    Ok(found) => {
+                        let error = (found.value_mm - length_mm) / length_mm;
+                        assert!(
+                            error.abs() < 0.1 && found.uncertainty_mm > 0.0,
+                            "{kind:?} {length_mm} mm: {found:?}"
+                        );
+                        assert_eq!(found.method, METHOD);
+                        sized += 1;
+                    }
+                    // Refusing is allowed (0.5 mm on the outer race: a third peak as strong
+                    // as the exit); a wrong number is not.
+                    Err(NotMeasured::NotResolved(_)) => {}
+                    Err(other) => panic!("{kind:?} {length_mm} mm: {other}"),
+                }
+            }
+        }
+        assert!(sized >= 5, "only {sized} of 6 sized");
+    }
+
+    #[test]
+    fn one_event_per_passage_is_not_sized() {
+        let (signal, rate) = signal_model(SimulatedFault::OuterRace, 48_000.0, 0.0);
+        let found = size(&signal, 48_000.0, FaultKind::OuterRace, rate);
+        assert!(
+            matches!(found, Err(NotMeasured::NotResolved(_))),
+            "{found:?}"
+        );
+    }
+
+    #[test]
+    fn noise_alone_is_not_sized() {
+        let mut rng = crate::random::Rng::new(3);
+        let signal: Vec<f32> = (0..96_000).map(|_| (0.2 * rng.normal()) as f32).collect();
+        let found = size(&signal, 48_000.0, FaultKind::OuterRace, 107.0);
+        assert!(found.is_err(), "{found:?}");
+    }
+
+    #[test]
+    fn below_40_khz_the_reason_says_so() {
+        let (signal, rate) = signal_model(SimulatedFault::OuterRace, 12_000.0, 2.0);
+        let found = size(&signal, 12_000.0, FaultKind::OuterRace, rate);
+        assert_eq!(
+            found.unwrap_err().to_string(),
+            "needs ≥ 40 kHz; this record is 12 kHz"
+        );
+    }
+
+    #[test]
+    fn only_race_defects_have_a_size() {
+        let (signal, rate) = signal_model(SimulatedFault::Ball, 48_000.0, 1.0);
+        for fault in [FaultKind::Ball, FaultKind::Cage] {
+            let found = size(&signal, 48_000.0, fault, rate);
+            assert!(
+                matches!(found, Err(NotMeasured::NotARaceFault(_))),
+                "{found:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn unusable_inputs_are_errors_not_panics() {
+        let (signal, rate) = signal_model(SimulatedFault::OuterRace, 48_000.0, 1.0);
+        for (fs, f, band) in [
+            (f64::NAN, rate, Band::new(2e3, 4e3)),
+            (48e3, 0.0, Band::new(2e3, 4e3)),
+            (48e3, rate, Band::new(4e3, 2e3)),
+            (48e3, rate, Band::new(2e3, 40e3)),
+        ] {
+            let bearing = BearingGeometry::from_catalog("skf-6205-2rs").unwrap();
+            let found = measure_defect_size(&signal, fs, FaultKind::OuterRace, f, band, &bearing);
+            assert!(matches!(found, Err(NotMeasured::BadInput(_))), "{found:?}");
+        }
+        let short = size(&signal[..1_000], 48_000.0, FaultKind::OuterRace, rate);
+        assert!(
+            matches!(short, Err(NotMeasured::TooFewImpacts { .. })),
+            "{short:?}"
+        );
+        assert!(size(&[], 48_000.0, FaultKind::OuterRace, rate).is_err());
+    }
+}

@@ -211,3 +211,53 @@ pub fn summarize(outcomes: &[SizingOutcome]) -> SizingSummary {
         within_two_sigma: sized.iter().filter(|s| s.1 <= 2.0).count(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Issue 30's target on the physics twin: every size reported within ±50 % (the full grid
+    /// gives 17 % at most, DIAGNOSIS.md §5), the widths the estimator resolves sized, the ones
+    /// below its resolution refused rather than sized wrongly. About 2 s in release.
+    #[test]
+    fn sizes_on_the_physics_twin_stay_within_half_the_true_width() {
+        let outcomes: Vec<SizingOutcome> =
+            ci_cases().iter().map(|case| case.run().unwrap()).collect();
+        let mut report = String::new();
+        for o in &outcomes {
+            report += &format!(
+                "\n  {:?} {} mm at {} rpm, {} N, {} Hz: {:?} (verdict {:?})",
+                o.case.fault,
+                o.case.width_mm,
+                o.case.rpm,
+                o.case.load_n,
+                o.case.resonance_hz,
+                o.size,
+                o.verdict
+            );
+        }
+        for o in &outcomes {
+            if let Some(error) = o.relative_error() {
+                assert!(error.abs() <= 0.5, "error {error:.2}:{report}");
+            }
+            if o.case.width_mm >= 0.5 {
+                assert!(o.size.is_ok() && o.named(), "not sized:{report}");
+            }
+        }
+        let summary = summarize(&outcomes);
+        assert!(summary.sized >= 4, "{summary:?}:{report}");
+        assert_eq!(summary.within_two_sigma, summary.sized, "{report}");
+    }
+
+    #[test]
+    fn the_grid_is_the_one_the_issue_asks_for() {
+        let grid = full_grid(0.05);
+        assert_eq!(grid.len(), 2 * 6 * 2 * 2 * 2);
+        assert!(grid
+            .iter()
+            .all(|c| c.fs_hz == 48_000.0 && c.noise_g == 0.05));
+        for case in ci_cases() {
+            assert!(grid.contains(&case), "{case:?} is not in the grid");
+        }
+    }
+}
