@@ -44,10 +44,15 @@
 //!
 //! Sans-IO: samples in, a size or the reason there is none out; no clock, no file.
 
+mod average;
+mod events;
+
 use super::band::Band;
 use super::diagnosis::Verdict;
 use super::record::RecordAnalysis;
 use crate::bearing::{BearingGeometry, FaultKind, Race};
+use average::Average;
+use events::Events;
 use rustfft::num_complex::Complex64;
 use rustfft::FftPlanner;
 use serde::Serialize;
@@ -98,7 +103,7 @@ pub enum NotMeasured {
     #[error("needs ≥ 40 kHz; this record is {} kHz", fmt_khz(*.fs_hz))]
     SampleRateTooLow { fs_hz: f64 },
     #[error(
-        "only a race defect (outer or inner) has an entry and an exit to time; the verdict is {0}"
+        "the verdict is {0}: only an outer- or inner-race defect has an entry and an exit to time"
     )]
     NotARaceFault(&'static str),
     #[error("{0} is not usable for sizing")]
@@ -118,14 +123,15 @@ fn fmt_khz(fs_hz: f64) -> String {
     }
 }
 
-/// The defect size of the race fault the verdict names, in the band and at the fitted fault
-/// frequency the analysis found for it.
-pub fn measure_in_analysis(
+/// The defect size of the race fault `verdict` names (the analysis's, or the one a second
+/// opinion made of it), in the band and at the fitted fault frequency the analysis found for it.
+pub fn measure_for_verdict(
     signal: &[f32],
     analysis: &RecordAnalysis,
+    verdict: Verdict,
     bearing: &BearingGeometry,
 ) -> Result<DefectSize, NotMeasured> {
-    match analysis.diagnosis.verdict {
+    match verdict {
         Verdict::OuterRace => measure_for_fault(signal, analysis, FaultKind::OuterRace, bearing),
         Verdict::InnerRace => measure_for_fault(signal, analysis, FaultKind::InnerRace, bearing),
         other => Err(NotMeasured::NotARaceFault(other.name())),
@@ -327,411 +333,10 @@ fn vertex(values: &[f64], i: usize) -> f64 {
     }
 }
 
-/// The aligned segments around the impacts: raw, for the whitening and the Wiener weights.
-struct Average {
-    segments: Vec<Vec<f64>>,
-}
-
-impl Average {
-    fn of(
-        fft: &mut Fft,
-        signal: &[f32],
-        fs_hz: f64,
-        band: Band,
-        period: f64,
-        len: usize,
-    ) -> Result<Self, NotMeasured> {
-        let n = signal.len();
-        let mean = signal.iter().map(|&v| f64::from(v)).sum::<f64>() / n.max(1) as f64;
-        let x: Vec<f64> = signal.iter().map(|&v| f64::from(v) - mean).collect();
-        let analytic = analytic_in_band(fft, &x, fs_hz, band);
-        let envelope: Vec<f64> = analytic.iter().map(|v| v.norm()).collect();
-        let impacts = strong_impacts(&envelope, period, len);
-        if impacts.len() < MIN_IMPACTS {
-            return Err(NotMeasured::TooFewImpacts {
-                found: impacts.len(),
-                needed: MIN_IMPACTS,
-            });
-        }
-        let before = len / 2;
-        let band_segments: Vec<Vec<Complex64>> = impacts
-            .iter()
-            .map(|&i| analytic[i - before..i - before + len].to_vec())
-            .collect();
-        let shifts = alignment(fft, &band_segments);
-        let segments = impacts
-            .iter()
-            .zip(&shifts)
-            .map(|(&i, &shift)| {
-                let raw: Vec<Complex64> = x[i - before..i - before + len]
-                    .iter()
-                    .map(|&v| Complex64::new(v, 0.0))
-                    .collect();
-                delayed(fft, &raw, -shift).iter().map(|v| v.re).collect()
-            })
-            .collect();
-        Ok(Average { segments })
-    }
-
-    /// Each aligned segment through the whitening filter of the average's AR model.
-    fn whitened(&self, fs_hz: f64) -> Vec<Vec<f64>> {
-        let order = ((fs_hz / 3_000.0).round() as usize).clamp(8, 64);
-        let average = mean_of(self.segments.iter());
-        let a = ar_whitener(&average, order);
-        self.segments
-            .iter()
-            .map(|s| {
-                (0..s.len())
-                    .map(|n| {
-                        if n < order {
-                            0.0
-                        } else {
-                            a.iter().enumerate().map(|(k, ak)| ak * s[n - k]).sum()
-                        }
-                    })
-                    .collect()
-            })
-            .collect()
-    }
-
-    /// Per frequency bin, `1 − noise/signal` (clamped to 0…1): the power of the average over
-    /// the standard error of the mean from the impact-to-impact spread, both smoothed over 5
-    /// bins.
-    fn wiener_weights(&self, fft: &mut Fft) -> Vec<f64> {
-        let spectra: Vec<Vec<Complex64>> = self.segments.iter().map(|s| fft.of_real(s)).collect();
-        let len = spectra.first().map_or(0, Vec::len);
-        let count = spectra.len().max(1) as f64;
-        let mut signal = vec![0.0; len];
-        let mut noise = vec![0.0; len];
-        for k in 0..len {
-            let mean = spectra.iter().map(|s| s[k]).sum::<Complex64>() / count;
-            signal[k] = mean.norm_sqr();
-            noise[k] = spectra
-                .iter()
-                .map(|s| (s[k] - mean).norm_sqr())
-                .sum::<f64>()
-                / count
-                / count;
-        }
-        let smooth = |v: &[f64]| -> Vec<f64> {
-            (0..v.len())
-                .map(|k| {
-                    v[k.saturating_sub(2)..(k + 3).min(v.len())]
-                        .iter()
-                        .sum::<f64>()
-                        / 5.0
-                })
-                .collect()
-        };
-        let (signal, noise) = (smooth(&signal), smooth(&noise));
-        signal
-            .iter()
-            .zip(&noise)
-            .map(|(s, n)| {
-                if *s > 0.0 {
-                    (1.0 - n / s).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                }
-            })
-            .collect()
-    }
-}
-
-/// The analytic signal of `x` restricted to `band`, by one FFT of the whole record.
-fn analytic_in_band(fft: &mut Fft, x: &[f64], fs_hz: f64, band: Band) -> Vec<Complex64> {
-    let n = x.len();
-    let mut buf = fft.of_real(x);
-    for (k, v) in buf.iter_mut().enumerate() {
-        let f = bin_frequency(k, n) * fs_hz;
-        *v *= if f >= band.lo_hz && f <= band.hi_hz && f > 0.0 {
-            2.0
-        } else {
-            0.0
-        };
-    }
-    fft.inverse(&mut buf);
-    buf
-}
-
-/// The envelope's maximum in each fault period, followed from period to period (±¼ period),
-/// keeping those at least half the 90th percentile and with a whole segment of `len` around.
-fn strong_impacts(envelope: &[f64], period: f64, len: usize) -> Vec<usize> {
-    let n = envelope.len();
-    let mut found = Vec::new();
-    let mut at = argmax(envelope, 0, period as usize) as f64;
-    while (at as usize) < n {
-        let from = (at - 0.25 * period).max(0.0) as usize;
-        let to = ((at + 0.25 * period) as usize).min(n);
-        if to <= from {
-            break;
-        }
-        let peak = argmax(envelope, from, to);
-        found.push(peak);
-        at = peak as f64 + period;
-    }
-    let mut amplitudes: Vec<f64> = found.iter().map(|&i| envelope[i]).collect();
-    amplitudes.sort_by(f64::total_cmp);
-    let p90 = amplitudes
-        .get((0.9 * amplitudes.len() as f64) as usize)
-        .copied()
-        .unwrap_or(0.0);
-    let before = len / 2;
-    found
-        .into_iter()
-        .filter(|&i| envelope[i] >= 0.5 * p90 && i >= before && i - before + len <= n)
-        .collect()
-}
-
-/// Each segment's delay against the average, in samples: the sub-sample peak of the circular
-/// cross-correlation magnitude, re-averaged once with the delays undone.
-fn alignment(fft: &mut Fft, segments: &[Vec<Complex64>]) -> Vec<f64> {
-    let len = segments.first().map_or(0, Vec::len);
-    let spectra: Vec<Vec<Complex64>> = segments
-        .iter()
-        .map(|s| {
-            let mut b = s.clone();
-            fft.forward(&mut b);
-            b
-        })
-        .collect();
-    let mut reference = mean_spectrum(&spectra, &vec![0.0; spectra.len()]);
-    let mut shifts = vec![0.0; spectra.len()];
-    for _ in 0..2 {
-        for (shift, spectrum) in shifts.iter_mut().zip(&spectra) {
-            let mut cross: Vec<Complex64> = reference
-                .iter()
-                .zip(spectrum)
-                .map(|(r, s)| r.conj() * s)
-                .collect();
-            fft.inverse(&mut cross);
-            let magnitude: Vec<f64> = cross.iter().map(|v| v.norm()).collect();
-            let k = argmax(&magnitude, 0, len);
-            let wrap = |i: isize| magnitude[i.rem_euclid(len as isize) as usize];
-            let (a, b, c) = (wrap(k as isize - 1), magnitude[k], wrap(k as isize + 1));
-            let curvature = a - 2.0 * b + c;
-            let mut lag = k as f64
-                + if curvature == 0.0 {
-                    0.0
-                } else {
-                    0.5 * (a - c) / curvature
-                };
-            if lag > len as f64 / 2.0 {
-                lag -= len as f64;
-            }
-            *shift = lag;
-        }
-        reference = mean_spectrum(&spectra, &shifts);
-    }
-    shifts
-}
-
-/// The mean of `spectra`, each advanced by its shift (samples).
-fn mean_spectrum(spectra: &[Vec<Complex64>], shifts: &[f64]) -> Vec<Complex64> {
-    let len = spectra.first().map_or(0, Vec::len);
-    let mut mean = vec![Complex64::new(0.0, 0.0); len];
-    for (spectrum, shift) in spectra.iter().zip(shifts) {
-        for (k, (m, v)) in mean.iter_mut().zip(spectrum).enumerate() {
-            *m += v * Complex64::from_polar(1.0, TAU * bin_frequency(k, len) * shift);
-        }
-    }
-    let count = spectra.len().max(1) as f64;
-    mean.iter_mut().for_each(|m| *m /= count);
-    mean
-}
-
-/// The prediction-error filter `[1, a₁, …, a_p]` of the Yule–Walker AR model of `x`
-/// (Levinson–Durbin on the biased autocorrelation).
-fn ar_whitener(x: &[f64], order: usize) -> Vec<f64> {
-    let n = x.len();
-    let mean = x.iter().sum::<f64>() / n.max(1) as f64;
-    let r: Vec<f64> = (0..=order)
-        .map(|lag| {
-            (lag..n)
-                .map(|i| (x[i] - mean) * (x[i - lag] - mean))
-                .sum::<f64>()
-                / n.max(1) as f64
-        })
-        .collect();
-    let mut a = vec![0.0; order + 1];
-    a[0] = 1.0;
-    let mut error = r[0];
-    for k in 1..=order {
-        if error <= 0.0 {
-            break;
-        }
-        let acc: f64 = (0..k).map(|j| a[j] * r[k - j]).sum();
-        let reflection = -acc / error;
-        let previous = a.clone();
-        for j in 1..k {
-            a[j] = previous[j] + reflection * previous[k - j];
-        }
-        a[k] = reflection;
-        error *= 1.0 - reflection * reflection;
-    }
-    a
-}
-
-/// A resolved entry and exit, in samples of the segment.
-#[derive(Debug, Clone, Copy)]
-struct Pair {
-    entry: f64,
-    exit: f64,
-    /// Half-width at half maximum of the stronger event, samples.
-    half_width: f64,
-}
-
-/// How the events are read off a whitened average.
-struct Events<'a> {
-    fs_hz: f64,
-    weights: &'a [f64],
-    max_delay: usize,
-    min_separation: usize,
-}
-
-impl Events<'_> {
-    /// The smoothed envelope of `x`, Wiener-weighted, above [`HIGH_PASS_HZ`].
-    fn envelope(&self, fft: &mut Fft, x: &[f64]) -> Vec<f64> {
-        let n = x.len();
-        let mut buf = fft.of_real(x);
-        for (k, v) in buf.iter_mut().enumerate() {
-            let f = bin_frequency(k, n);
-            let keep = f > 0.0 && f * self.fs_hz >= HIGH_PASS_HZ;
-            *v *= if keep { 2.0 * self.weights[k] } else { 0.0 };
-        }
-        fft.inverse(&mut buf);
-        let magnitude: Vec<f64> = buf.iter().map(|v| v.norm()).collect();
-        let sigma = self.fs_hz / 48_000.0;
-        let reach = (3.0 * sigma) as isize;
-        let kernel: Vec<f64> = (-reach..=reach)
-            .map(|i| (-0.5 * (i as f64 / sigma).powi(2)).exp())
-            .collect();
-        let total: f64 = kernel.iter().sum();
-        (0..n as isize)
-            .map(|i| {
-                kernel
-                    .iter()
-                    .zip(-reach..)
-                    .filter_map(|(w, d)| {
-                        usize::try_from(i + d)
-                            .ok()
-                            .and_then(|j| magnitude.get(j))
-                            .map(|m| w * m)
-                    })
-                    .sum::<f64>()
-                    / total
-            })
-            .collect()
-    }
-
-    /// The entry and exit: the two most prominent peaks within the longest delay of the
-    /// strongest event, if they are clear (module documentation, step 5).
-    fn pair(&self, envelope: &[f64]) -> Result<Pair, NotMeasured> {
-        let n = envelope.len();
-        let strongest = argmax(envelope, n / 4, 3 * n / 4);
-        let from = strongest.saturating_sub(self.max_delay).max(1);
-        let to = (strongest + self.max_delay + 1).min(n - 1);
-        let mut peaks: Vec<(usize, f64)> = (from..to)
-            .filter(|&i| envelope[i] >= envelope[i - 1] && envelope[i] > envelope[i + 1])
-            .map(|i| (i, prominence(&envelope[from - 1..=to], i + 1 - from)))
-            .collect();
-        peaks.sort_by(|a, b| b.1.total_cmp(&a.1));
-        let Some(&(first, first_prominence)) = peaks.first() else {
-            return Err(NotMeasured::NotResolved("no event in the average".into()));
-        };
-        let mut others = peaks
-            .iter()
-            .filter(|(i, _)| i.abs_diff(first) >= self.min_separation);
-        let floor = median(envelope);
-        let Some(&(second, second_prominence)) = others.next() else {
-            return Err(NotMeasured::NotResolved(
-                "one event only (the entry and exit merge: the defect is shorter than the time resolution)".into(),
-            ));
-        };
-        if second_prominence < MIN_PROMINENCE_RATIO * first_prominence
-            || second_prominence < MIN_PROMINENCE_OVER_MEDIAN * floor
-        {
-            return Err(NotMeasured::NotResolved(format!(
-                "one event only: the next one stands {:.1}× the strongest and {:.1}× the noise (needs {MIN_PROMINENCE_RATIO} and {MIN_PROMINENCE_OVER_MEDIAN})",
-                second_prominence / first_prominence,
-                second_prominence / floor
-            )));
-        }
-        if let Some(&(_, third)) = others.next() {
-            if third > MAX_THIRD_RATIO * second_prominence {
-                return Err(NotMeasured::NotResolved(format!(
-                    "a third event as strong ({:.0} % of the second) makes the pair ambiguous",
-                    100.0 * third / second_prominence
-                )));
-            }
-        }
-        let half = 0.5 * envelope[first];
-        let left = (0..first).rev().find(|&i| envelope[i] < half).unwrap_or(0);
-        let right = (first..n).find(|&i| envelope[i] < half).unwrap_or(n - 1);
-        let (a, b) = (first.min(second), first.max(second));
-        Ok(Pair {
-            entry: vertex(envelope, a),
-            exit: vertex(envelope, b),
-            half_width: 0.5 * (right - left) as f64,
-        })
-    }
-
-    /// The spacing in each interleaved sub-average: the envelope's maximum within ±half the
-    /// minimum separation of each event, both standing clear of that sub-average's noise.
-    fn sub_average_spacings(
-        &self,
-        fft: &mut Fft,
-        whitened: &[Vec<f64>],
-        pair: Pair,
-    ) -> Result<Vec<f64>, NotMeasured> {
-        let reach = (self.min_separation / 2).max(2);
-        (0..SUB_AVERAGES)
-            .map(|k| {
-                let envelope =
-                    self.envelope(fft, &mean_of(whitened.iter().skip(k).step_by(SUB_AVERAGES)));
-                let near = |at: f64| {
-                    let centre = at.round() as usize;
-                    argmax(&envelope, centre.saturating_sub(reach), centre + reach + 1)
-                };
-                let (entry, exit) = (near(pair.entry), near(pair.exit));
-                let floor = median(&envelope);
-                if envelope[entry].min(envelope[exit]) < MIN_SUB_EVENT_OVER_MEDIAN * floor {
-                    return Err(NotMeasured::NotResolved(format!(
-                        "the events do not stand out in every sub-average ({:.1}× the noise in one, needs {MIN_SUB_EVENT_OVER_MEDIAN})",
-                        envelope[entry].min(envelope[exit]) / floor
-                    )));
-                }
-                Ok(vertex(&envelope, exit) - vertex(&envelope, entry))
-            })
-            .collect()
-    }
-}
-
-/// Prominence of the peak at `i` of `values`: its height above the higher of the lowest points
-/// on either side before a higher value (or the slice's end).
-fn prominence(values: &[f64], i: usize) -> f64 {
-    let height = values[i];
-    let mut left_base = height;
-    for &v in values[..i].iter().rev() {
-        if v > height {
-            break;
-        }
-        left_base = left_base.min(v);
-    }
-    let mut right_base = height;
-    for &v in &values[i + 1..] {
-        if v > height {
-            break;
-        }
-        right_base = right_base.min(v);
-    }
-    height - left_base.max(right_base)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::twin::{SimulatedFault, SimulationParams, Simulator};
+    use bearing_signal::simulate::{SimulatedFault, SimulationParams, Simulator};
 
     /// Two seconds of the signal model's race defect with entry and exit impacts `length_mm`
     /// apart (0: one impact per passage), resonance 3 kHz.
