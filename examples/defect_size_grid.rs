@@ -9,6 +9,7 @@
 //! the summary; the time to simulate and size the records is measured here, outside the
 //! library (the library has no clock).
 
+use bearingd::analysis::defect_size::NotMeasured;
 use bearingd::bearing::FaultKind;
 use bearingd::twin::defect_size::{full_grid, summarize, SizingOutcome, WIDTHS_MM};
 use rayon::prelude::*;
@@ -90,17 +91,33 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 100.0 * s.mean_abs_error
             );
         }
-        let mut reasons: Vec<String> = outcomes
+        let mut reasons: std::collections::BTreeMap<String, usize> = Default::default();
+        for why in outcomes.iter().filter_map(|o| o.size.as_ref().err()) {
+            let text = match why {
+                NotMeasured::NotResolved(detail) => detail.clone(),
+                other => other.to_string(),
+            };
+            let short = text
+                .split(['(', ':'])
+                .next()
+                .unwrap_or_default()
+                .trim()
+                .to_string();
+            *reasons.entry(short).or_default() += 1;
+        }
+        let reasons: Vec<String> = reasons
             .iter()
-            .filter_map(|o| o.size.as_ref().err())
-            .map(|e| {
-                let text = e.to_string();
-                text.split(['(', ':']).take(2).collect::<Vec<_>>().join(":")
-            })
+            .map(|(why, n)| format!("{why} ({n})"))
             .collect();
-        reasons.sort();
-        reasons.dedup();
         println!("  why none: {}", reasons.join("; "));
+        let named = outcomes
+            .iter()
+            .filter(|o| o.size.is_ok() && o.named())
+            .count();
+        println!(
+            "  sized and named by the verdict (what analyze reports): {named} of {}",
+            s.sized
+        );
         println!("  † the verdict does not name the simulated fault: analyze would report no size");
     }
     Ok(())
