@@ -217,7 +217,7 @@ mod tests {
     use super::*;
 
     /// Issue 30's target on the physics twin: every size reported within ±50 % (the full grid
-    /// gives 17 % at most, DIAGNOSIS.md §5), the widths the estimator resolves sized, the ones
+    /// gives 17 % at most at 0.05 g, 23 % at 0.2 g; DIAGNOSIS.md §5), the widths the estimator resolves sized, the ones
     /// below its resolution refused rather than sized wrongly. About 2 s in release.
     #[test]
     fn sizes_on_the_physics_twin_stay_within_half_the_true_width() {

@@ -16,13 +16,13 @@
 //!    inner-race defect strikes hard only in the load zone.
 //! 2. **Synchronous average**: a segment of 0.9 periods around each impact, aligned to the
 //!    average by the sub-sample peak of their cross-correlation in the band (two passes), then
-//!    averaged: the thousands of impacts add coherently, the noise does not. Averaging at the
+//!    averaged: the hundreds or thousands of impacts add coherently, the noise does not. Averaging at the
 //!    nominal period instead smears: 1 % slip walks the impacts by many samples over a record.
 //! 3. **Whitening**: an AR model of order `fs/3000` (16 at 48 kHz; Yule–Walker) of the
 //!    *average* removes the structure's ringing, so what remains is where force enters: the
 //!    entry and the exit. Fitted on the whole record instead, the model whitens the noise floor
 //!    more than the resonance, and the ringing left over made a false "exit" 0.4 ms after a
-//!    single event (0.3 mm read as 0.53 mm, 0.1 mm as 1.2 mm).
+//!    single event (0.3 mm read as 0.53 mm, 0.2 mm as 1.25 mm).
 //! 4. **Events**: the envelope of the whitened average, each frequency weighted by how far the
 //!    average stands above the impact-to-impact spread there (a Wiener weight: the whitening
 //!    would otherwise lift the bare noise of the high frequencies), above 1 kHz, smoothed over
@@ -35,12 +35,12 @@
 //! The uncertainty combines the spread of the sub-averages' spacings (standard error of their
 //! mean), the sample grid, and half the main event's half-width at half maximum: the peaks of
 //! two events closer than about their width pull towards each other, which is where the
-//! twin's largest errors (−10 … −20 %) are.
+//! twin's largest errors (−10 … −23 %) are.
 //!
 //! What we tried and dropped: the power cepstrum of the average (its echo peak drowns in the
-//! resonance's own cepstrum: no peak at the spacing for 0.1–1 mm at a 3 kHz resonance), and
-//! the whitened envelope without the Wiener weight (reported 34 of the 96 grid records where
-//! the chosen method reports 48, with the same error).
+//! resonance's own cepstrum: no clear peak at the spacing for 0.1–1 mm at a 3 kHz resonance), and
+//! the whitened envelope without the Wiener weight (the prototype sized 34 of the 96 grid
+//! records instead of 48, with the same errors).
 //!
 //! Sans-IO: samples in, a size or the reason there is none out; no clock, no file.
 
