@@ -10,9 +10,9 @@
 //!
 //! # How (each step chosen by measurement on the physics twin, DIAGNOSIS.md §5)
 //!
-//! 1. **Find the impacts**: the analytic signal of the record (its first 20 s) in the fault's band; its envelope's
-//!    maximum in each fault period (searched ±¼ period around the last one plus a period, so
-//!    slip is followed). Only the strong ones (≥ half the 90th percentile) are kept: an
+//! 1. **Find the impacts**: the analytic signal of the record (its first 20 s) in the fault's
+//!    band; its envelope's maximum in each fault period (searched ±¼ period around the last one
+//!    plus a period, so slip is followed). Only the strong ones (≥ half the 90th percentile) are kept: an
 //!    inner-race defect strikes hard only in the load zone.
 //! 2. **Synchronous average**: a segment of 0.9 periods around each impact, aligned to the
 //!    average by the sub-sample peak of their cross-correlation in the band (two passes), then
