@@ -6,6 +6,7 @@
 //! SKF 6205-2RS). Every assumption is written into the report's warnings; what cannot be
 //! resolved is an error that says which option gives it.
 
+use crate::analysis::defect_size::measure_for_verdict;
 use crate::analysis::iso::{record_severity, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
@@ -359,6 +360,7 @@ pub fn analyze_recording(
         report.set_twin(TwinReport::new(&twin, fit_ms, agrees, note), &combined);
         twin
     });
+    let mut verdict = analysis.diagnosis.verdict;
     if let Some(model) = &request.learned {
         let opinion = model
             .opinion(&samples, fs_hz, rpm / 60.0, &report.bearing_geometry)
@@ -372,6 +374,7 @@ pub fn analyze_recording(
             &request.settings.decision_rule(),
         );
         let combined = combine_learned(&view, &opinion);
+        verdict = combined.verdict;
         if opinion.segments == 0 {
             let segment = model.card.features.segment_revolutions;
             report.warnings.push(format!(
@@ -381,6 +384,14 @@ pub fn analyze_recording(
         }
         report.set_learned(opinion, combined);
     }
+    // After the verdict is final: only a named race fault is sized. Not in the daemon's
+    // per-window path: it needs the whole record's impacts.
+    report.set_defect_size(measure_for_verdict(
+        &samples,
+        &analysis,
+        verdict,
+        &report.bearing_geometry,
+    ));
     Ok(AnalyzeOutcome {
         analysis,
         report,

@@ -13,12 +13,14 @@
 //! - [`record`]: all of the above over one whole record (`bearingd analyze`).
 //! - [`speed`]: the shaft speed estimated from the spectrum near a nominal speed.
 //! - [`iso`]: velocity severity and zones after ISO 10816-3 / 20816-3.
+//! - [`defect_size`]: a race defect's length from its entry and exit events (≥ 40 kHz).
 //! - [`degradation`]: the trend of RMS over life with its time to the failure limit (a life
 //!   of snapshots is walked by `offline::life`, which also needs the twin).
 
 pub mod band;
 pub mod band_search;
 pub mod band_selection;
+pub mod defect_size;
 pub mod degradation;
 pub mod diagnosis;
 pub mod envelope;

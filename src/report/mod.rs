@@ -13,6 +13,7 @@ pub use life::{
 };
 pub use text::render_text;
 
+use crate::analysis::defect_size::{DefectSize, NotMeasured};
 use crate::analysis::diagnosis::{DecisionRule, Diagnosis, Verdict};
 use crate::analysis::fault_bands::HarmonicPeak;
 use crate::analysis::indicators::Indicators;
@@ -153,6 +154,12 @@ pub struct AnalyzeReport {
     /// report's `diagnosis` is then the combined one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub learned: Option<LearnedReport>,
+    /// The race defect's length from the spacing of its entry and exit events
+    /// ([`crate::analysis::defect_size`]): only for an outer- or inner-race verdict on a record
+    /// of ≥ 40 kHz whose events are clear; else `null`, and `defect_size_note` says why.
+    pub defect_size_mm: Option<DefectSizeReport>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub defect_size_note: Option<String>,
     pub warnings: Vec<String>,
 }
 
@@ -164,6 +171,20 @@ pub struct LearnedReport {
     pub envelope_diagnosis: &'static str,
     pub basis: Basis,
     pub learned_agrees: bool,
+}
+
+/// The `defect_size_mm` object of the JSON report.
+#[derive(Debug, Clone, Serialize)]
+pub struct DefectSizeReport {
+    /// Circumferential length of the defect, mm.
+    pub value: f64,
+    /// One standard uncertainty, mm.
+    pub uncertainty: f64,
+    pub method: &'static str,
+    /// The entry-to-exit time it comes from, ms.
+    pub delay_ms: f64,
+    /// Impacts in the synchronous average.
+    pub impacts: usize,
 }
 
 /// The twin's errors per hypothesis.
@@ -254,6 +275,26 @@ impl AnalyzeReport {
         self.reason = combined.reason.clone();
         self.twin = Some(twin);
         self.settle_plain();
+    }
+
+    /// Adds the defect size, or why there is none.
+    pub fn set_defect_size(&mut self, size: Result<DefectSize, NotMeasured>) {
+        match size {
+            Ok(size) => {
+                self.defect_size_mm = Some(DefectSizeReport {
+                    value: size.value_mm,
+                    uncertainty: size.uncertainty_mm,
+                    method: size.method,
+                    delay_ms: size.delay_s * 1e3,
+                    impacts: size.impacts,
+                });
+                self.defect_size_note = None;
+            }
+            Err(why) => {
+                self.defect_size_mm = None;
+                self.defect_size_note = Some(why.to_string());
+            }
+        }
     }
 
     /// Adds the learned opinion; the diagnosis becomes the combined one.
@@ -419,6 +460,8 @@ impl AnalyzeReport {
             velocity: None,
             twin: None,
             learned: None,
+            defect_size_mm: None,
+            defect_size_note: None,
             warnings: context.warnings.clone(),
         };
         report.settle_plain();

@@ -2,6 +2,7 @@
 //! technician, [`super::plain`]), then the evidence for the engineer.
 
 use super::{AnalyzeReport, SpeedSource};
+use crate::messages::FaultKind;
 use std::fmt::Write;
 
 /// Renders the report as a few aligned lines of text.
@@ -120,6 +121,22 @@ pub fn render_text(r: &AnalyzeReport) -> String {
             probabilities.join(", "),
             l.envelope_diagnosis
         );
+    }
+    let race_fault = [FaultKind::OuterRace, FaultKind::InnerRace]
+        .iter()
+        .any(|f| f.name() == r.diagnosis);
+    match (&r.defect_size_mm, &r.defect_size_note) {
+        (Some(size), _) => {
+            let _ = writeln!(
+                out,
+                "  defect size: {:.2} ± {:.2} mm (entry to exit {:.3} ms over {} impacts; {})",
+                size.value, size.uncertainty, size.delay_ms, size.impacts, size.method
+            );
+        }
+        (None, Some(note)) if race_fault => {
+            let _ = writeln!(out, "  defect size: not reported: {note}");
+        }
+        _ => {}
     }
     let i = &r.indicators;
     let _ = writeln!(

@@ -4,6 +4,7 @@
 //! The physics twin (MODELS.md §5, [`physics`]): the 6-DOF contact model and its calibration.
 
 pub mod dataset;
+pub mod defect_size;
 pub mod diagnose;
 pub mod fit;
 pub mod hw;

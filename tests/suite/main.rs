@@ -6,6 +6,7 @@ mod alerts;
 mod cli;
 mod daemon;
 mod dataset;
+mod defect_size;
 mod developer_set;
 mod envelope;
 mod evaluate_recordings;
