@@ -13,7 +13,11 @@
 //!   for ok, each counted over the history it rests on ([`FaultFlag::update_over`]). So the
 //!   flags accumulate the evidence of the whole horizon, not of one window, and the end of a
 //!   signal ([`ChannelMonitor::finish`]) leaves them on the verdict `analyze` gives the same
-//!   samples. Until the first selection the channel is learning and raises no flag.
+//!   samples. (choice) Only a verdict on a whole horizon moves the flags (or, at the signal's
+//!   end, one on all there is): the first seconds and the seconds after a gap choose bands but
+//!   decide nothing, so every decision rests on the same amount of evidence and has the same
+//!   false-alarm rate (a verdict on 3 s of a CWRU ball record named the inner race that 10 s
+//!   do not). Until the first selection the channel is learning and raises no flag.
 //! - Scores: every hop, each fault's score in its own band's rolling (averaged) envelope
 //!   spectrum, for the log, the status and the twin: what the spectrum shows now.
 //! - Health: the stage tracker, fed with each window's kurtosis and RMS, and the RMS trend
@@ -279,6 +283,9 @@ pub struct ChannelMonitor {
     /// The fewest samples of history a selection analyses (one window, or the whole history
     /// if shorter).
     min_evidence_samples: usize,
+    /// The signal has ended ([`Self::finish`]): a verdict on less than a whole horizon moves
+    /// the flags too.
+    ending: bool,
     /// The velocity severity and its zone flag (`None` when off).
     velocity: Option<(VelocityTracker, FaultFlag)>,
 }
@@ -385,6 +392,7 @@ impl ChannelMonitor {
             band_job_from: 0,
             evidence_until: 0,
             min_evidence_samples: window.min(settings.band_history_samples.max(1)),
+            ending: false,
             freqs,
             orders,
             speed_known,
@@ -757,7 +765,10 @@ impl ChannelMonitor {
             evidence: evidence.as_ref(),
             evidence_from: self.band_job_from,
         });
-        if let Some(evidence) = evidence {
+        // The flags move on a whole horizon of evidence, or on all there is at the signal's end:
+        // a shorter stretch (the first seconds, the seconds after a gap) chooses bands only.
+        if let Some(evidence) = evidence.filter(|e| e.samples >= self.history.len() || self.ending)
+        {
             self.follow_evidence(&evidence, on_event);
         }
     }
@@ -793,6 +804,7 @@ impl ChannelMonitor {
     /// selection) gets a last selection over the history, used at once, so that the flags end
     /// on the verdict of everything the channel saw.
     pub fn finish(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
+        self.ending = true;
         if self.band_result_at.is_some() {
             self.use_band_result(on_event);
         }

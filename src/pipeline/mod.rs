@@ -242,6 +242,12 @@ pub fn band_history_s(config: &Config) -> f64 {
     config.evidence_horizon_s
 }
 
+/// Seconds of sample time to a channel's first band selection: one band period, or the
+/// evidence horizon if that fills first (as the monitor schedules it).
+pub fn first_selection_s(config: &Config) -> f64 {
+    config.band_period_s.min(config.evidence_horizon_s)
+}
+
 /// Seconds of sample time from a band selection's start (on the worker thread) to the sample
 /// where its bands are used: 2 s, or half the band period if that is shorter. Long enough for
 /// the worker to finish the selections of many channels (30–100 ms each) before the analysis
@@ -362,7 +368,7 @@ impl Pipeline {
                         fs_hz,
                         status,
                         next_spectrum: 0,
-                        next_twin: (band_history_s(config) * fs_hz) as u64,
+                        next_twin: (first_selection_s(config) * fs_hz) as u64,
                     },
                 );
             }

@@ -63,8 +63,12 @@ fn a_python_subscriber_receives_the_raised_alert_of_a_simulated_fault() {
         String::from_utf8_lossy(&daemon.stderr)
     );
     let sample = raised_at(&stdout);
-    // Raised at watch (the ramping fault's comb stands alone), then escalated to alarm.
-    assert!(stdout.contains("2 alerts published"), "{stdout}");
+    // Raised once the band selection's evidence (10 s, all of it faulty) names the fault: at
+    // watch or straight at alarm, then perhaps escalated; the subscriber asked for the first.
+    assert!(
+        stdout.contains("1 alerts published") || stdout.contains("2 alerts published"),
+        "{stdout}"
+    );
 
     let received = subscriber.wait_with_output().unwrap();
     let text = String::from_utf8_lossy(&received.stdout);

@@ -88,9 +88,10 @@ pub fn write_raw_log(log: &RawLog) -> Result<WrittenLog, RawLogError> {
          --config {out}/replay.toml after editing it)\n\
          [[sensors]]\nid = \"{sensor}\"\ntransport = \"shm\"\nsample_rate_hz = {fs}\nscale_g_per_count = {scale:e}\naxes = [\"radial\"]\nbearing = \"{bearing_spec}\"\n\
          [sensors.speed]\nsource = \"fixed\"\nrpm = {rpm}\n\n\
-         # A recording is one piece of evidence: the verdict rests on all of it (up to 600 s), as\n\
-         # `bearingd analyze`'s does, decided at its end; flags rise on 1 s of evidence.\n\
-         [analysis]\nband_period_s = {horizon}\nevidence_horizon_s = {horizon}\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 5.0\nbaseline_windows = 5\n\n\
+         # A recording is one piece of evidence: the verdict rests on all of it so far (up to\n\
+         # 600 s), as `bearingd analyze`'s does on the whole, and is decided again every 3 s\n\
+         # and at its end; flags rise and fall on 1 s of evidence.\n\
+         [analysis]\nband_period_s = 3.0\nevidence_horizon_s = {horizon}\n\n[thresholds]\non_delay_s = 1.0\noff_delay_s = 1.0\nbaseline_windows = 5\n\n\
          [outputs]\nstate_dir = \"{out}/state\"\nmcap_dir = \"{out}/replay\"\n",
         what = log.what,
         horizon = evidence_horizon_s(signal.samples.len(), fs),
@@ -210,9 +211,9 @@ pub fn recording_date(file: &Path) -> (u64, &'static str) {
     }
 }
 
-/// The evidence horizon (and band period) a recording is replayed with: its whole length, so
-/// that its verdict is decided once, on all of it (up to the longest horizon the config
-/// allows); written with enough digits to hold every sample.
+/// The evidence horizon a recording is replayed with: its whole length, so that its last
+/// verdict rests on all of it (up to the longest horizon the config allows); written with
+/// enough digits to hold every sample.
 fn evidence_horizon_s(samples: usize, fs_hz: f64) -> String {
     let seconds = (samples as f64 / fs_hz).clamp(1e-3, MAX_HORIZON_S);
     format!("{:.6}", (seconds * 1e6).ceil() / 1e6)
