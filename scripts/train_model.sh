@@ -2,8 +2,9 @@
 # Makes the shipped learned model from nothing but the simulators: the two synthetic data sets
 # (signal model and physics twin) and the training, seeded. Usage:
 #   scripts/train_model.sh [OUT]      (default OUT: models/skf-6205-2rs.safetensors)
-# About a minute on two cores. CI runs it into target/ and checks the result is the committed
-# file, byte for byte (the same binary, seeds and thread count give the same weights).
+# About a minute on two cores. CI runs it into target/ and scripts/check_model.py checks the
+# result is the committed model: byte for byte on a machine like the one that made it, the same
+# card, accuracy and verdicts on another CPU (whose SIMD kernels round sums in another order).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-models/skf-6205-2rs.safetensors}
