@@ -101,3 +101,69 @@ fn the_sweep_is_deterministic_whatever_the_threads() {
     assert_eq!(csv(&one), csv(&two));
     assert_eq!(one.len(), 5);
 }
+
+/// Issue 30 item 4, CI-sized: half an hour of healthy signal (10 min on each of the three
+/// machines, shared by both speeds and four noise levels, with the nuisance) streamed through
+/// the daemon's channel monitor raises no fault flag. The product's requirement is 0 flags on a
+/// healthy machine; the hours-long measurement (`bearingd evaluate --false-alarm-hours`) is in
+/// docs/DIAGNOSIS.md. A failure lists each flag with its case, time, fault and score.
+#[test]
+fn healthy_machines_raise_no_flag_in_half_an_hour() {
+    use bearingd::evaluate::false_alarms::{stream_run, summarize_false_alarms, FalseAlarmPlan};
+    let bench = Bench::embedded().expect("the embedded default config validates");
+    // A seed of its own: these runs are not the start of the documented measurement's (seed 1).
+    let plan = FalseAlarmPlan::new(1.0 / 6.0, 30);
+    let runs = plan.runs();
+    let results = bearingd::evaluate::in_order(
+        &runs,
+        2,
+        || (),
+        |(), run| stream_run(&bench, &plan, run),
+        &|_, _, _| {},
+    );
+    let summary = summarize_false_alarms(&results);
+    assert!(
+        (summary.all.hours - 0.5).abs() < 1e-9,
+        "simulated {} h, not 0.5 h",
+        summary.all.hours
+    );
+    // Each 75 s run decides at 10 s (its history full), every 20 s after (30, 50, 70 s) and
+    // at its end: 5 verdicts the flags follow.
+    assert_eq!(
+        summary.all.decisions,
+        5 * runs.len() as u64,
+        "the monitor did not decide as often as its band period asks"
+    );
+    assert!(
+        summary.rises.is_empty(),
+        "{} fault flag(s) rose on healthy machines in {:.2} h ({} decisions):\n{}",
+        summary.rises.len(),
+        summary.all.hours,
+        summary.all.decisions,
+        summary.rises.join("\n")
+    );
+
+    // The count is not vacuous: the same path counts the flag of a fault (an outer race of the
+    // default severity, on the CWRU machine at nominal speed and the simulator's noise).
+    let mut faulty = runs
+        .iter()
+        .find(|r| {
+            r.case.machine == 0
+                && r.case.rpm == plan.machines[0].nominal_rpm
+                && r.case.noise == NoiseLevel::SimulatorDefault
+        })
+        .cloned()
+        .expect("the plan runs the CWRU machine at nominal speed and the simulator's noise");
+    faulty.case.fault = SimulatedFault::OuterRace;
+    faulty.case.severity = 1.0;
+    faulty.seconds = 30.0;
+    let result = stream_run(&bench, &plan, &faulty);
+    assert!(
+        result
+            .rises
+            .iter()
+            .any(|r| r.fault == bearingd::messages::FaultKind::OuterRace),
+        "an outer-race fault raised no outer-race flag in 30 s: {:?}",
+        result.rises
+    );
+}

@@ -1,19 +1,25 @@
 //! `bearingd evaluate`: sweep the simulator through the real pipeline and report how well the
 //! detector does; with `--recordings`, real recordings of a manifest through `analyze` and
-//! through the daemon's replay (see `crate::evaluate` and docs/DIAGNOSIS.md).
+//! through the daemon's replay; with `--false-alarm-hours`, hours of healthy signal through the
+//! daemon's channel monitor (see `crate::evaluate` and docs/DIAGNOSIS.md).
 
 use super::CliError;
+use crate::evaluate::false_alarms::{
+    render_false_alarms, stream_run, summarize_false_alarms, FalseAlarmPlan, FalseAlarmSummary,
+    RunResult,
+};
 use crate::evaluate::recordings::{
     evaluate_recordings, plan, render_recordings, tally, Entry, Manifest, RecordingsOptions,
     RecordingsReport, Said,
 };
 use crate::evaluate::{
-    pd_figure, render_csv, render_tables, run_sweep, summarize, Bench, Path as JudgedPath, Summary,
-    Sweep,
+    in_order, pd_figure, render_csv, render_tables, run_sweep, summarize, Bench,
+    Path as JudgedPath, Summary, Sweep,
 };
 use crate::twin::Nuisance;
 use clap::Args;
 use serde::Serialize;
+use std::fmt::Write as _;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -26,6 +32,19 @@ pub struct EvaluateArgs {
     /// `bearingd import` + `replay`; writes recordings.json. May be given several times.
     #[arg(long, value_name = "MANIFEST", conflicts_with_all = ["quick", "config", "no_nuisance"])]
     recordings: Vec<PathBuf>,
+    /// Instead of the sweep: H hours of healthy simulated signal per machine (the full sweep's
+    /// three machines at 0.6 and 1 × nominal speed, four noise levels, with the nuisance)
+    /// streamed through the daemon's channel monitor; counts the fault flags that rise (false
+    /// alarms) per hour of operation; writes false_alarms.json and false_alarms.txt. Without
+    /// a value: 2 h per machine (about 2.5 min of CPU).
+    #[arg(
+        long,
+        value_name = "H",
+        num_args = 0..=1,
+        default_missing_value = "2",
+        conflicts_with_all = ["recordings", "quick"]
+    )]
+    false_alarm_hours: Option<f64>,
     /// With --recordings: also the other channels of each record (CWRU fan end and base,
     /// every axis of other files; IMS snapshots are always evaluated on all eight).
     #[arg(long, requires = "recordings")]
@@ -70,12 +89,10 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     if !args.recordings.is_empty() {
         return run_recordings(args);
     }
-    let bench = match &args.config {
-        Some(path) => Bench {
-            config: crate::config::load(path).map_err(CliError::input)?,
-        },
-        None => Bench::embedded().map_err(CliError::failure)?,
-    };
+    let bench = bench(args)?;
+    if let Some(hours) = args.false_alarm_hours {
+        return run_false_alarms(args, &bench, hours);
+    }
     let mut sweep = if args.quick {
         Sweep::quick(args.seed)
     } else {
@@ -144,6 +161,151 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The embedded default config, or `--config`'s.
+fn bench(args: &EvaluateArgs) -> Result<Bench, CliError> {
+    match &args.config {
+        Some(path) => Ok(Bench {
+            config: crate::config::load(path).map_err(CliError::input)?,
+        }),
+        None => Bench::embedded().map_err(CliError::failure),
+    }
+}
+
+/// A progress bar on a terminal (`None` elsewhere: the caller prints lines).
+fn progress_bar(total: u64, template: &str) -> Option<indicatif::ProgressBar> {
+    std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new(total);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(template)
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    })
+}
+
+/// What false_alarms.json holds.
+#[derive(Serialize)]
+struct FalseAlarmsFile<'a> {
+    plan: &'a FalseAlarmPlan,
+    summary: &'a FalseAlarmSummary,
+    /// CPU time of the whole process (every thread), s; `None` if it cannot be read.
+    cpu_s: Option<f64>,
+    wall_s: f64,
+    runs: &'a [RunResult],
+}
+
+/// `evaluate --false-alarm-hours H`: hours of healthy signal through the monitor path.
+fn run_false_alarms(args: &EvaluateArgs, bench: &Bench, hours: f64) -> Result<(), CliError> {
+    if !(hours.is_finite() && hours > 0.0 && hours <= 10_000.0) {
+        return Err(CliError::input(format!(
+            "--false-alarm-hours {hours}: give the hours of healthy signal per machine, above 0 \
+             and at most 10000, e.g. --false-alarm-hours 2"
+        )));
+    }
+    let mut plan = FalseAlarmPlan::new(hours, args.seed);
+    if args.no_nuisance {
+        plan.nuisance = Nuisance::none();
+    }
+    create_out(&args.out)?;
+    let threads = threads(args)?;
+    let runs = plan.runs();
+    eprintln!(
+        "evaluate: false alarms, {hours} h of healthy signal on each of {} machines ({:.1} h in \
+         {} runs of {:.0} s), seed {}, {threads} threads",
+        plan.machines.len(),
+        plan.total_hours(),
+        runs.len(),
+        runs.first().map_or(0.0, |r| r.seconds),
+        plan.seed
+    );
+    let started = Instant::now();
+    let cpu_at_start = process_cpu_s();
+    let bar = progress_bar(
+        runs.len() as u64,
+        "evaluate {bar:20} {pos}/{len} runs ({eta}) {wide_msg}",
+    );
+    let simulated = std::sync::Mutex::new((0.0f64, 0usize));
+    let progress = |done: usize, total: usize, result: &RunResult| {
+        let (hours, rises) = {
+            let mut seen = simulated.lock().unwrap_or_else(|e| e.into_inner());
+            seen.0 += result.run.seconds / 3600.0;
+            seen.1 += result.rises.len();
+            *seen
+        };
+        let line = format!("{hours:.1} h simulated, {rises} flag rise(s)");
+        match &bar {
+            Some(bar) => {
+                bar.set_position(done as u64);
+                bar.set_message(line);
+            }
+            None if done == total || (done * 4 / total) != ((done - 1) * 4 / total) => {
+                eprintln!("evaluate: {done}/{total} runs, {line}");
+            }
+            None => {}
+        }
+    };
+    let results = in_order(
+        &runs,
+        threads,
+        || (),
+        |(), run| stream_run(bench, &plan, run),
+        &progress,
+    );
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    let wall_s = started.elapsed().as_secs_f64();
+    let cpu_s = process_cpu_s()
+        .zip(cpu_at_start)
+        .map(|(end, start)| end - start);
+    let summary = summarize_false_alarms(&results);
+    let mut table = render_false_alarms(&summary);
+    let _ = writeln!(
+        table,
+        "{:.1} h simulated in {wall_s:.0} s of wall time{}",
+        summary.all.hours,
+        cpu_s.map_or(String::new(), |cpu| format!(
+            ", {cpu:.0} s of CPU: {:.1} simulated h per CPU minute",
+            summary.all.hours / (cpu / 60.0).max(1e-9)
+        ))
+    );
+    print!("{table}");
+    let json = serde_json::to_vec_pretty(&FalseAlarmsFile {
+        plan: &plan,
+        summary: &summary,
+        cpu_s,
+        wall_s,
+        runs: &results,
+    })
+    .map_err(|e| CliError::failure(format!("cannot encode the results as JSON: {e}")))?;
+    let written = [
+        write_out(&args.out, "false_alarms.json", &json)?,
+        write_out(&args.out, "false_alarms.txt", table.as_bytes())?,
+    ];
+    eprintln!(
+        "evaluate: wrote {} and {}",
+        display(&written[0]),
+        display(&written[1])
+    );
+    Ok(())
+}
+
+/// CPU time used so far by the whole process (every thread, user and system), s.
+fn process_cpu_s() -> Option<f64> {
+    let mut usage = std::mem::MaybeUninit::<libc::rusage>::uninit();
+    // SAFETY: getrusage writes the struct it is given before returning 0; it is read only
+    // then.
+    #[allow(unsafe_code)]
+    let usage = unsafe {
+        if libc::getrusage(libc::RUSAGE_SELF, usage.as_mut_ptr()) != 0 {
+            return None;
+        }
+        usage.assume_init()
+    };
+    let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    Some(seconds(usage.ru_utime) + seconds(usage.ru_stime))
+}
+
 fn display(path: &Path) -> String {
     path.display().to_string()
 }
@@ -201,16 +363,10 @@ fn run_recordings(args: &EvaluateArgs) -> Result<(), CliError> {
         options.jobs
     );
     let started = Instant::now();
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = indicatif::ProgressBar::new(tasks.len() as u64);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "evaluate {bar:20} {pos}/{len} ({eta}) {wide_msg}",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar
-    });
+    let bar = progress_bar(
+        tasks.len() as u64,
+        "evaluate {bar:20} {pos}/{len} ({eta}) {wide_msg}",
+    );
     let progress = |done: usize, total: usize, entry: &Entry| {
         let said = |path| Said::of(path, entry).name();
         let line = format!(

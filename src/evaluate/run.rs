@@ -7,6 +7,7 @@
 //!   as the sensor's integer counts in blocks with their sample positions, in sample time.
 
 use super::sweep::{Case, Machine, NoiseLevel, Sweep, DEFAULT_SEVERITY};
+use crate::analysis::diagnosis::DecisionRule;
 use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisSettings, Diagnosis, Verdict};
@@ -172,14 +173,6 @@ pub struct Bench {
     pub config: Config,
 }
 
-/// The sensor's scale, g per count: the embedded default's (±16 g in an i16).
-fn scale_g_per_count(config: &Config) -> f64 {
-    config
-        .sensors
-        .first()
-        .map_or(0.000_488, |s| s.scale_g_per_count)
-}
-
 impl Bench {
     /// The embedded default config: the analysis and flag settings a new user's daemon runs.
     pub fn embedded() -> Result<Self, String> {
@@ -191,13 +184,22 @@ impl Bench {
         &self.config.analysis
     }
 
+    /// The sensor's scale, g per count: the config's first sensor's (the embedded default's:
+    /// ±16 g in an i16).
+    pub fn scale_g_per_count(&self) -> f64 {
+        self.config
+            .sensors
+            .first()
+            .map_or(0.000_488, |s| s.scale_g_per_count)
+    }
+
     /// The monitor settings the daemon would derive for a sensor on `machine` at `rpm`.
     pub fn monitor_settings(&self, machine: &Machine, rpm: f64) -> MonitorSettings {
         let sensor = SensorConfig {
             id: "evaluate".into(),
             transport: Transport::Sim(SimConfig::default()),
             sample_rate_hz: machine.fs_hz,
-            scale_g_per_count: scale_g_per_count(&self.config),
+            scale_g_per_count: self.scale_g_per_count(),
             axes: vec!["radial".into()],
             bearing: machine.bearing.clone(),
             speed: Speed::Fixed { rpm },
@@ -243,7 +245,54 @@ fn fault_rms_g(params: &SimulationParams) -> f64 {
 }
 
 /// Samples per block fed to the monitor (0.1 s at 12 kHz, like a sensor's frames batched).
-const BLOCK: usize = 1200;
+pub(super) const BLOCK: usize = 1200;
+
+/// What a case simulates: the simulator's parameters with the case's noise set, and the noise
+/// and SNR that gives.
+pub struct CaseSignal {
+    pub params: SimulationParams,
+    /// RMS of the broadband noise (white and shaft-modulated), g.
+    pub noise_g: f64,
+    /// The fault's RMS over the broadband noise's, dB (`None` for healthy records).
+    pub snr_db: Option<f64>,
+}
+
+impl CaseSignal {
+    /// The signal of `case` on `machine` with `nuisance`: an SNR sets the broadband noise (the
+    /// white noise and the nuisance's shaft-modulated noise together, in the preset's
+    /// proportion between them) against the fault's RMS, or for a healthy case against an
+    /// outer-race fault's of the default severity.
+    pub fn of(case: &Case, machine: &Machine, nuisance: &Nuisance) -> Self {
+        let mut params = params_of(case, machine, nuisance);
+        let fault_rms = fault_rms_g(&params);
+        let modulation_power = 1.0 + 0.5 * params.nuisance.modulation_depth.powi(2);
+        let modulated_per_white = params.nuisance.modulated_noise_g / params.noise_g.max(1e-12);
+        let broadband_per_white = (1.0 + modulated_per_white.powi(2) * modulation_power).sqrt();
+        if let NoiseLevel::Snr(db) = case.noise {
+            let reference = if case.fault == SimulatedFault::None {
+                let outer = Case {
+                    fault: SimulatedFault::OuterRace,
+                    severity: DEFAULT_SEVERITY,
+                    ..case.clone()
+                };
+                fault_rms_g(&params_of(&outer, machine, &Nuisance::none()))
+            } else {
+                fault_rms
+            };
+            let broadband = reference / 10f64.powf(db / 20.0);
+            params.noise_g = broadband / broadband_per_white;
+            params.nuisance.modulated_noise_g = modulated_per_white * params.noise_g;
+        }
+        let noise_g = params.noise_g * broadband_per_white;
+        let snr_db = (case.fault != SimulatedFault::None && noise_g > 0.0)
+            .then(|| 20.0 * (fault_rms / noise_g).log10());
+        CaseSignal {
+            params,
+            noise_g,
+            snr_db,
+        }
+    }
+}
 
 /// Runs one case through both paths.
 pub fn run_case(
@@ -253,34 +302,13 @@ pub fn run_case(
     analyzer: &mut RecordAnalyzer,
 ) -> CaseResult {
     let machine = &sweep.machines[case.machine];
-    let mut params = params_of(case, machine, &sweep.nuisance);
-    let fault_rms = fault_rms_g(&params);
-    // The broadband noise is the white noise and the nuisance's shaft-modulated noise
-    // together: an SNR sets both, in the preset's proportion between them.
-    let modulation_power = 1.0 + 0.5 * params.nuisance.modulation_depth.powi(2);
-    let modulated_per_white = params.nuisance.modulated_noise_g / params.noise_g.max(1e-12);
-    let broadband_per_white = (1.0 + modulated_per_white.powi(2) * modulation_power).sqrt();
-    if let NoiseLevel::Snr(db) = case.noise {
-        let reference = if case.fault == SimulatedFault::None {
-            let outer = Case {
-                fault: SimulatedFault::OuterRace,
-                severity: DEFAULT_SEVERITY,
-                ..case.clone()
-            };
-            fault_rms_g(&params_of(&outer, machine, &Nuisance::none()))
-        } else {
-            fault_rms
-        };
-        let broadband = reference / 10f64.powf(db / 20.0);
-        params.noise_g = broadband / broadband_per_white;
-        params.nuisance.modulated_noise_g = modulated_per_white * params.noise_g;
-    }
-    let broadband_g = params.noise_g * broadband_per_white;
-    let snr_db = (case.fault != SimulatedFault::None && broadband_g > 0.0)
-        .then(|| 20.0 * (fault_rms / broadband_g).log10());
+    let CaseSignal {
+        params,
+        noise_g,
+        snr_db,
+    } = CaseSignal::of(case, machine, &sweep.nuisance);
     let freqs = params.frequencies();
     let fs = params.fs_hz;
-    let noise_g = broadband_g;
     let signal = Simulator::record(params, sweep.monitor_s);
 
     let record_len = ((sweep.record_s * fs).round() as usize).min(signal.len());
@@ -290,11 +318,9 @@ pub fn run_case(
         .map_err(|e| e.to_string());
 
     let settings = bench.monitor_settings(machine, case.rpm);
-    let scale = scale_g_per_count(&bench.config);
-    let counts: Vec<i16> = signal
-        .iter()
-        .map(|&g| (f64::from(g) / scale).round().clamp(-32768.0, 32767.0) as i16)
-        .collect();
+    let scale = bench.scale_g_per_count();
+    let mut counts = Vec::new();
+    to_counts(&signal, scale, &mut counts);
     let monitor = run_monitor(settings, freqs, &counts, scale);
 
     CaseResult {
@@ -304,6 +330,17 @@ pub fn run_case(
         record,
         monitor,
     }
+}
+
+/// The sensor's integer counts of a signal in g (rounded, clamped to the i16 range), into
+/// `counts` (cleared first).
+pub fn to_counts(signal: &[f32], scale_g_per_count: f64, counts: &mut Vec<i16>) {
+    counts.clear();
+    counts.extend(signal.iter().map(|&g| {
+        (f64::from(g) / scale_g_per_count)
+            .round()
+            .clamp(-32768.0, 32767.0) as i16
+    }));
 }
 
 /// What the record path concluded, from its analysis.
@@ -321,6 +358,172 @@ pub fn record_outcome(
     }
 }
 
+/// A flag that rose from ok: which fault, to what level, when, and the verdict it followed.
+#[derive(Debug, Clone, Serialize)]
+pub struct FlagRise {
+    pub fault: FaultKind,
+    pub level: FlagLevel,
+    /// Sample time of the rise, s from the start of the run.
+    pub at_s: f64,
+    /// The fault's score in the verdict's evidence, its comb's frequency, and the largest
+    /// score of the other faults.
+    pub score: f64,
+    pub frequency_hz: f64,
+    pub runner_up: f64,
+}
+
+impl FlagRise {
+    pub fn describe(&self) -> String {
+        format!(
+            "{} {} at {:.1} s (score {:.1} at {:.1} Hz, runner-up {:.1})",
+            self.fault.name(),
+            self.level.name(),
+            self.at_s,
+            self.score,
+            self.frequency_hz,
+            self.runner_up
+        )
+    }
+}
+
+/// The fault score of a verdict's evidence that came nearest to being named on its own size and
+/// significance ([`DecisionRule::naming_margin`]): on a healthy machine, how near a run came
+/// to a false alarm.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct StrongestEvidence {
+    pub fault: FaultKind,
+    /// Sample time of the verdict, s from the start of the run.
+    pub at_s: f64,
+    pub score: f64,
+    /// `−log10` p of the comb against noise.
+    pub significance: f64,
+    /// Log units: positive when the comb was large and significant enough to be named, were no
+    /// other fault near it; −0.69 is half the size (or 0.3 decades short of the significance)
+    /// it needed.
+    pub margin: f64,
+}
+
+impl StrongestEvidence {
+    pub fn describe(&self) -> String {
+        format!(
+            "{} {:.1} at p = 10^-{:.1}, margin {:+.2} (at {:.0} s)",
+            self.fault.name(),
+            self.score,
+            self.significance,
+            self.margin,
+            self.at_s
+        )
+    }
+}
+
+/// Watches a channel monitor's events: each flag's level and the highest it reached, the rises
+/// from ok, the decisions (band selections with their verdict), the strongest evidence of any
+/// of them, and the windows scored after the first one.
+pub struct MonitorWatch {
+    fs_hz: f64,
+    rule: DecisionRule,
+    strongest: Option<StrongestEvidence>,
+    level: [FlagLevel; 4],
+    highest: [FlagLevel; 4],
+    rises: Vec<FlagRise>,
+    decisions: u64,
+    windows_scored: u64,
+    windows_flagged: u64,
+}
+
+impl MonitorWatch {
+    /// For a monitor with `settings`.
+    pub fn new(settings: &MonitorSettings) -> Self {
+        MonitorWatch {
+            fs_hz: settings.fs_hz,
+            rule: settings.analysis.decision_rule(),
+            strongest: None,
+            level: [FlagLevel::Ok; 4],
+            highest: [FlagLevel::Ok; 4],
+            rises: Vec::new(),
+            decisions: 0,
+            windows_scored: 0,
+            windows_flagged: 0,
+        }
+    }
+
+    pub fn see(&mut self, event: MonitorEvent) {
+        match event {
+            MonitorEvent::Bands {
+                evidence,
+                at_sample,
+                ..
+            } => {
+                self.decisions += 1;
+                for score in evidence.iter().flat_map(|e| e.scores.iter()) {
+                    let margin = self.rule.naming_margin(score);
+                    if self.strongest.is_none_or(|s| margin > s.margin) {
+                        self.strongest = Some(StrongestEvidence {
+                            fault: score.fault,
+                            at_s: at_sample as f64 / self.fs_hz,
+                            score: score.score,
+                            significance: score.significance,
+                            margin,
+                        });
+                    }
+                }
+            }
+            MonitorEvent::Flag {
+                fault,
+                change,
+                score,
+                frequency_hz,
+                runner_up,
+            } => {
+                let index = FaultKind::ALL.iter().position(|&k| k == fault).unwrap_or(0);
+                self.level[index] = change.to;
+                self.highest[index] = self.highest[index].max(change.to);
+                if change.from == FlagLevel::Ok && change.to > FlagLevel::Ok {
+                    self.rises.push(FlagRise {
+                        fault,
+                        level: change.to,
+                        at_s: change.at_sample as f64 / self.fs_hz,
+                        score,
+                        frequency_hz,
+                        runner_up,
+                    });
+                }
+            }
+            MonitorEvent::Window(_) if self.decisions > 0 => {
+                self.windows_scored += 1;
+                if self.level.iter().any(|&l| l > FlagLevel::Ok) {
+                    self.windows_flagged += 1;
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// The rises from ok so far, in order.
+    pub fn rises(&self) -> &[FlagRise] {
+        &self.rises
+    }
+
+    /// Band selections so far: each a verdict the flags followed.
+    pub fn decisions(&self) -> u64 {
+        self.decisions
+    }
+
+    pub fn strongest(&self) -> Option<StrongestEvidence> {
+        self.strongest
+    }
+
+    pub fn outcome(&self) -> MonitorOutcome {
+        MonitorOutcome {
+            highest: self.highest,
+            first_flag_s: self.rises.first().map(|rise| rise.at_s),
+            windows_scored: self.windows_scored,
+            windows_flagged: self.windows_flagged,
+            predicted: Predicted::of_flags(self.highest),
+        }
+    }
+}
+
 /// Feeds the counts to a fresh channel monitor block by block and watches its flags.
 fn run_monitor(
     settings: MonitorSettings,
@@ -328,41 +531,13 @@ fn run_monitor(
     counts: &[i16],
     scale: f64,
 ) -> MonitorOutcome {
-    let fs = settings.fs_hz;
+    let mut watch = MonitorWatch::new(&settings);
+    let mut see = |event: MonitorEvent| watch.see(event);
     let mut monitor = ChannelMonitor::new(settings, freqs, None);
-    let mut level = [FlagLevel::Ok; 4];
-    let mut highest = [FlagLevel::Ok; 4];
-    let mut first_flag = None;
-    let mut bands_known = false;
-    let (mut scored, mut flagged) = (0u64, 0u64);
-    let mut watch = |event: MonitorEvent| match event {
-        MonitorEvent::Bands { .. } => bands_known = true,
-        MonitorEvent::Flag { fault, change, .. } => {
-            let index = FaultKind::ALL.iter().position(|&k| k == fault).unwrap_or(0);
-            level[index] = change.to;
-            highest[index] = highest[index].max(change.to);
-            if change.to > change.from && first_flag.is_none() {
-                first_flag = Some(change.at_sample as f64 / fs);
-            }
-        }
-        MonitorEvent::Window(_) if bands_known => {
-            scored += 1;
-            if level.iter().any(|&l| l > FlagLevel::Ok) {
-                flagged += 1;
-            }
-        }
-        _ => {}
-    };
     for (i, block) in counts.chunks(BLOCK).enumerate() {
-        monitor.push_counts((i * BLOCK) as u64, block, scale, &mut watch);
+        monitor.push_counts((i * BLOCK) as u64, block, scale, &mut see);
     }
     // The record's end, as a replay's: the last verdict on what was not analysed yet.
-    monitor.finish(&mut watch);
-    MonitorOutcome {
-        highest,
-        first_flag_s: first_flag,
-        windows_scored: scored,
-        windows_flagged: flagged,
-        predicted: Predicted::of_flags(highest),
-    }
+    monitor.finish(&mut see);
+    watch.outcome()
 }

@@ -190,7 +190,7 @@ impl Sweep {
                                     repeat,
                                     seed: 0,
                                 };
-                                case.seed = case.derive_seed(self.seed);
+                                case.seed = case.derive_seed("", self.seed);
                                 cases.push(case);
                             }
                         }
@@ -220,10 +220,11 @@ pub struct Case {
 
 impl Case {
     /// FNV-1a over the sweep seed and the case's coordinates: stable across builds, orders
-    /// and thread counts.
-    fn derive_seed(&self, sweep_seed: u64) -> u64 {
+    /// and thread counts. `stream` keeps the seeds of another use of the same coordinates
+    /// apart from the sweep's ("" for the sweep).
+    pub(super) fn derive_seed(&self, stream: &str, sweep_seed: u64) -> u64 {
         let key = format!(
-            "{sweep_seed}|{}|{}|{}|{}|{}|{}",
+            "{stream}{sweep_seed}|{}|{}|{}|{}|{}|{}",
             self.fault.name(),
             self.bearing,
             self.rpm.to_bits(),
