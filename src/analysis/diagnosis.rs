@@ -191,17 +191,6 @@ impl<'a> Contest<'a> {
         Some(Contest { leader, runner_up })
     }
 
-    /// The leader, when it is significant and separable from every other significant
-    /// hypothesis: the fault the daemon's flags follow (its flag's thresholds then act on the
-    /// score), and whether it stands alone (then its flag rises to watch at least).
-    pub fn lead(&self, rule: &DecisionRule) -> Option<(FaultKind, Named)> {
-        if self.named(rule) == Some(Named::Alone) {
-            return Some((self.leader.fault, Named::Alone));
-        }
-        (rule.significant(self.leader) && self.separated(rule))
-            .then_some((self.leader.fault, Named::BySize))
-    }
-
     /// How the leader is named, if it is.
     pub fn named(&self, rule: &DecisionRule) -> Option<Named> {
         if rule.detected(self.leader) && self.separated(rule) {

@@ -200,6 +200,67 @@ fn the_daemon_path_flags_what_import_and_replay_flag() {
     assert_eq!(by_evaluate, by_cli);
 }
 
+/// Issue 30 item 4: "a 2.5 s record that analyze diagnoses is flagged by the daemon too". The
+/// first 2.5 s of two CWRU drive-end records (outer race 130, inner race 105), as plain CSV
+/// files a user might have, through both paths: analyze names the fault and the daemon's flags
+/// (import + replay) say the same.
+#[test]
+fn a_two_and_a_half_second_record_that_analyze_names_is_flagged_by_the_daemon() {
+    let Some(cwru) = shared_data_dir("cwru") else {
+        return;
+    };
+    let out = scratch_dir("evaluate-recordings-short");
+    let mut manifest = String::from("file,fault,rpm,fs_hz,bearing,sensor_location\n");
+    for (record, fault) in [
+        ("12k_Drive_End_OR007@6_0_130.mat", "outer"),
+        ("12k_Drive_End_IR007_0_105.mat", "inner"),
+    ] {
+        let options = bearingd::recording::ReadOptions {
+            channel: Some("DE".to_string()),
+            column: None,
+        };
+        let full = bearingd::recording::read_recording(&cwru.join(record), &options).unwrap();
+        let short: String = full.samples[..30_000]
+            .iter()
+            .map(|x| format!("{x}\n"))
+            .collect();
+        let name = record.replace(".mat", "_2.5s.csv");
+        std::fs::write(out.join(&name), short).unwrap();
+        manifest.push_str(&format!(
+            "{name},{fault},1797,12000,skf-6205-2rs,drive_end\n"
+        ));
+    }
+    let path = out.join("manifest.csv");
+    std::fs::write(&path, manifest).unwrap();
+    let entries = run(&[Manifest::read(&path).unwrap()], &out);
+    assert_eq!(entries.len(), 2);
+    for e in &entries {
+        let label = e.label();
+        let Ok(record) = &e.record else {
+            panic!("{label}: analyze failed: {:?}", e.record)
+        };
+        let Truth::Fault(fault) = e.truth else {
+            panic!("{label}: truth {:?}", e.truth)
+        };
+        assert_eq!(
+            record.predicted,
+            bearingd::evaluate::run::Predicted::Fault(fault),
+            "{label}: analyze on 2.5 s"
+        );
+        let DaemonOutcome::Judged { monitor, flags, .. } = &e.daemon else {
+            panic!(
+                "{label}: the daemon judged nothing on 2.5 s: {:?}",
+                e.daemon
+            )
+        };
+        assert_eq!(
+            monitor.predicted, record.predicted,
+            "{label}: flags {flags:?}"
+        );
+        assert_eq!(e.agree, Some(true), "{label}");
+    }
+}
+
 /// A missing manifest exits 2 naming it; a manifest whose files are missing is reported
 /// record by record and, under --strict, exits 1.
 #[test]

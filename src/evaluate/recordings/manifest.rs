@@ -122,6 +122,9 @@ pub struct ManifestRecord {
     /// `fs_hz` and `rpm`: used only where the file does not state them.
     pub fs_hz: Option<f64>,
     pub rpm: Option<f64>,
+    /// `bearing`: a catalog name or custom geometry, as `analyze --bearing` takes it; needed
+    /// where neither the file nor its data set says (a user's own CSV or WAV).
+    pub bearing: Option<String>,
     pub truth: Truth,
     pub truth_from: String,
     /// `sensor_location`: where the faulty bearing is (CWRU: `drive_end`).
@@ -245,6 +248,7 @@ fn record_of(
         channel: cell("channel_var").or(cell("channel")).map(String::from),
         fs_hz: number("fs_hz")?,
         rpm: number("rpm")?,
+        bearing: cell("bearing").map(String::from),
         truth,
         truth_from,
         location: cell("sensor_location").map(String::from),
@@ -325,10 +329,10 @@ mod tests {
 
     #[test]
     fn rows_resolve_against_the_manifest_folder() {
-        let text = "file,fault,fs_hz,rpm,channel_var,note\n\
-                    a.mat,inner,12000,1797,X105_DE_time,\n\
+        let text = "file,fault,fs_hz,rpm,channel_var,note,bearing\n\
+                    a.mat,inner,12000,1797,X105_DE_time,,\n\
                     \n\
-                    \"b, c.csv\",,,1800,,\"early life (healthy)\"\n";
+                    \"b, c.csv\",,,1800,,\"early life (healthy)\",skf-61804\n";
         let manifest = Manifest::parse(Path::new("/data/set/manifest.csv"), text).unwrap();
         let [a, b] = manifest.records.as_slice() else {
             panic!("{manifest:?}")
@@ -340,6 +344,10 @@ mod tests {
         assert_eq!(b.file, Path::new("/data/set/b, c.csv"));
         assert_eq!((b.line, b.channel.as_deref(), b.fs_hz), (4, None, None));
         assert_eq!(b.truth, Truth::Healthy);
+        assert_eq!(
+            (a.bearing.as_deref(), b.bearing.as_deref()),
+            (None, Some("skf-61804"))
+        );
 
         // Every channel sees the record's defect (the two bearings' fault orders coincide),
         // and says where it is.

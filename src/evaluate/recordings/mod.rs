@@ -319,6 +319,7 @@ pub fn evaluate_task(task: &Task, scratch: &Path, analyzer: &mut RecordAnalyzer)
         read,
         fs_hz: task.record.fs_hz.filter(|_| recording.fs_hz.is_none()),
         rpm: task.record.rpm.filter(|_| recording.rpm.is_none()),
+        bearing: task.record.bearing.clone(),
         ..AnalyzeRequest::default()
     };
     let conditions = match resolve_conditions(&recording, &request, false) {
