@@ -36,12 +36,14 @@ status_interval_s = 0.5
         state = dir.join("state").display(),
         mcap = dir.join("mcap").display(),
         // iceoryx2's root for the alert service: not under /tmp (the config refuses it).
-        iox = Path::new(env!("CARGO_TARGET_TMPDIR"))
-            .join(format!(
-                "iox-sd-{}",
+        iox = bearingd_testdata::iox_root(
+            env!("CARGO_TARGET_TMPDIR"),
+            &format!(
+                "sd-{}",
                 dir.file_name().unwrap_or_default().to_string_lossy()
-            ))
-            .display(),
+            )
+        )
+        .display(),
     );
     std::fs::write(&path, text)?;
     Ok(path)

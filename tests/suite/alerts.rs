@@ -2,7 +2,7 @@
 //! Python example (`examples/alerts_subscriber.py`, the `iceoryx2` package from PyPI)
 //! subscribe.
 
-use bearingd_testdata::{python_iceoryx2, scratch_dir};
+use bearingd_testdata::{iox_root, python_iceoryx2, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -102,7 +102,7 @@ fn a_python_subscriber_receives_the_raised_alert_of_a_simulated_fault() {
 /// `dir`, the iceoryx2 root under the target dir (the config refuses /tmp).
 fn fault_from_start_config(dir: &Path) -> PathBuf {
     // Short: iceoryx2's socket paths below it must fit in 108 bytes.
-    let iox = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("ia-{}", std::process::id()));
+    let iox = iox_root(env!("CARGO_TARGET_TMPDIR"), "ia");
     let text = format!(
         r#"
 [[sensors]]

@@ -5,7 +5,7 @@
 use crate::replay::replay_json;
 use bearingd::mcap_log::read_messages;
 use bearingd::messages::PipelineMessage;
-use bearingd_testdata::{check_mcap_with_python, mcap_files, python_mcap, scratch_dir};
+use bearingd_testdata::{check_mcap_with_python, iox_root, mcap_files, python_mcap, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -209,8 +209,7 @@ fn a_config_error_refuses_to_start_and_lists_every_problem() {
 fn a_simulated_node_over_iceoryx2_through_the_daemon_and_its_replay_give_the_same_flags() {
     let dir = scratch_dir("daemon-iox");
     // iceoryx2's root must not sit under /tmp (the config refuses it): use the target dir.
-    let iox_root =
-        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("iox-{}", std::process::id()));
+    let iox_root = iox_root(env!("CARGO_TARGET_TMPDIR"), "iox");
     std::fs::create_dir_all(&iox_root).unwrap();
     let prefix = format!("bdtest{}_", std::process::id());
     let config = format!(

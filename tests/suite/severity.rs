@@ -3,7 +3,7 @@
 //! record is an analytic sine, whose velocity RMS is known in closed form: a peak
 //! acceleration `a` g at `f` Hz is `a·g₀/(2πf)/√2` m/s RMS.
 
-use bearingd_testdata::scratch_dir;
+use bearingd_testdata::{iox_root, scratch_dir};
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -164,7 +164,7 @@ fn velocity_log(py: &Path, files: &[std::path::PathBuf]) -> Value {
 /// bearing fault, logging under `dir`.
 fn imbalance_config(dir: &Path, imbalance_g: f64) -> std::path::PathBuf {
     // Outside /tmp (the config refuses it there), short enough for iceoryx2's socket paths.
-    let iox = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("is-{}", std::process::id()));
+    let iox = iox_root(env!("CARGO_TARGET_TMPDIR"), "is");
     let text = format!(
         r#"[[sensors]]
 id = "motor-de"

@@ -63,6 +63,25 @@ pub fn scratch_dir(test: &str) -> PathBuf {
     dir
 }
 
+/// An iceoryx2 root for a test, unique per process and `tag`: below `target_tmp` (pass
+/// `env!("CARGO_TARGET_TMPDIR")`), or in `/dev/shm/bearingd-tests` when the checkout itself
+/// is under /tmp or /var/tmp, or so deep that the root would be too long. (why) The config
+/// refuses a root under /tmp (systemd's PrivateTmp= would hide it from subscribers) and one
+/// longer than 56 bytes (iceoryx2's Unix socket paths below it must fit in 108), and CI must
+/// pass from a clone in any directory. Keep `tag` short.
+pub fn iox_root(target_tmp: &str, tag: &str) -> PathBuf {
+    let name = format!("{tag}-{}", std::process::id());
+    let below_target = Path::new(target_tmp).join(&name);
+    let under_tmp = ["/tmp", "/var/tmp"]
+        .iter()
+        .any(|t| below_target.starts_with(t));
+    if under_tmp || below_target.as_os_str().len() > 50 {
+        Path::new("/dev/shm/bearingd-tests").join(name)
+    } else {
+        below_target
+    }
+}
+
 /// The `.mcap` files directly in `dir`, sorted by name (empty if it cannot be read).
 pub fn mcap_files(dir: &Path) -> Vec<PathBuf> {
     let mut files: Vec<PathBuf> = std::fs::read_dir(dir)

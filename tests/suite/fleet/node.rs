@@ -4,7 +4,7 @@
 //! line while it runs.
 
 use super::broker::{Mosquitto, NodeUser, GROUP};
-use bearingd_testdata::{python_sparkplug, scratch_dir};
+use bearingd_testdata::{iox_root, python_sparkplug, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -64,11 +64,10 @@ impl NodeSetup {
         std::fs::create_dir_all(&dir).unwrap();
         // Short: iceoryx2's socket paths below it must fit in 108 bytes.
         static COUNTER: AtomicUsize = AtomicUsize::new(0);
-        let iox = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!(
-            "fl-{}-{}",
-            std::process::id(),
-            COUNTER.fetch_add(1, Ordering::Relaxed)
-        ));
+        let iox = iox_root(
+            env!("CARGO_TARGET_TMPDIR"),
+            &format!("fl{}", COUNTER.fetch_add(1, Ordering::Relaxed)),
+        );
         let mut fleet = format!(
             "enabled = true\n\
              broker = \"mqtts://localhost:{port}\"\n\
