@@ -28,7 +28,7 @@ use std::time::Instant;
 pub struct EvaluateArgs {
     /// Instead of the simulator: every record of this manifest (CSV with a header: `file`
     /// relative to its folder, and `fault`, `note` or `life_frac` for the truth; `channel_var`,
-    /// `fs_hz`, `rpm`, `bearing` where the file does not say) through `bearingd analyze` and through
+    /// `fs_hz`, `rpm`, `bearing_geometry` where the file does not say) through `bearingd analyze` and through
     /// `bearingd import` + `replay`; writes recordings.json. May be given several times.
     #[arg(long, value_name = "MANIFEST", conflicts_with_all = ["quick", "config", "no_nuisance"])]
     recordings: Vec<PathBuf>,

@@ -210,7 +210,7 @@ fn a_two_and_a_half_second_record_that_analyze_names_is_flagged_by_the_daemon() 
         return;
     };
     let out = scratch_dir("evaluate-recordings-short");
-    let mut manifest = String::from("file,fault,rpm,fs_hz,bearing,sensor_location\n");
+    let mut manifest = String::from("file,fault,rpm,fs_hz,bearing_geometry,sensor_location\n");
     for (record, fault) in [
         ("12k_Drive_End_OR007@6_0_130.mat", "outer"),
         ("12k_Drive_End_IR007_0_105.mat", "inner"),

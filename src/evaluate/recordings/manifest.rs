@@ -122,8 +122,10 @@ pub struct ManifestRecord {
     /// `fs_hz` and `rpm`: used only where the file does not state them.
     pub fs_hz: Option<f64>,
     pub rpm: Option<f64>,
-    /// `bearing`: a catalog name or custom geometry, as `analyze --bearing` takes it; needed
-    /// where neither the file nor its data set says (a user's own CSV or WAV).
+    /// `bearing_geometry`: a catalog name or custom geometry, as `analyze --bearing` takes it;
+    /// needed where neither the file nor its data set says (a user's own CSV or WAV). Not
+    /// `bearing`: FEMTO and IMS manifests use that column for which bearing of the rig
+    /// (`Bearing1_2`, `Rexnord ZA-2115`), a name, not a geometry.
     pub bearing: Option<String>,
     pub truth: Truth,
     pub truth_from: String,
@@ -248,7 +250,7 @@ fn record_of(
         channel: cell("channel_var").or(cell("channel")).map(String::from),
         fs_hz: number("fs_hz")?,
         rpm: number("rpm")?,
-        bearing: cell("bearing").map(String::from),
+        bearing: cell("bearing_geometry").map(String::from),
         truth,
         truth_from,
         location: cell("sensor_location").map(String::from),
@@ -329,10 +331,10 @@ mod tests {
 
     #[test]
     fn rows_resolve_against_the_manifest_folder() {
-        let text = "file,fault,fs_hz,rpm,channel_var,note,bearing\n\
-                    a.mat,inner,12000,1797,X105_DE_time,,\n\
+        let text = "file,fault,fs_hz,rpm,channel_var,note,bearing_geometry,bearing\n\
+                    a.mat,inner,12000,1797,X105_DE_time,,,Bearing1_2\n\
                     \n\
-                    \"b, c.csv\",,,1800,,\"early life (healthy)\",skf-61804\n";
+                    \"b, c.csv\",,,1800,,\"early life (healthy)\",skf-61804,\n";
         let manifest = Manifest::parse(Path::new("/data/set/manifest.csv"), text).unwrap();
         let [a, b] = manifest.records.as_slice() else {
             panic!("{manifest:?}")
