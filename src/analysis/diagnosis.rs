@@ -152,11 +152,12 @@ impl DecisionRule {
     }
 }
 
-/// (choice) A comb named because it stands alone has every harmonic but one at least this many
-/// times its floor: on the simulator's machine (gear mesh, 100 Hz tone, shaft harmonics) the
-/// stray combs of healthy records at 0.6× speed reach 2–3 with two tall lines and three at the
-/// floor, while the weakest faults it should name show 2.7–3.8 on all five.
-const LONE_HARMONIC_RATIO: f64 = 2.0;
+/// (choice) A comb named because it stands alone (or with the learned model's agreement) has
+/// every harmonic but one at least this many times its floor: on the simulator's machine (gear
+/// mesh, 100 Hz tone, shaft harmonics) the stray combs of healthy records at 0.6× speed reach
+/// 2–3 with two tall lines and three at the floor, while the weakest faults it should name show
+/// 2.7–3.8 on all five.
+pub const LONE_HARMONIC_RATIO: f64 = 2.0;
 
 /// How the leader of a [`Contest`] was named.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -165,6 +166,11 @@ pub enum Named {
     BySize,
     /// A weaker comb with nothing near it (`lone_fault_score`, `lone_score_ratio`).
     Alone,
+    /// A weaker comb, clear of the runner-up, that the learned model names too: the network
+    /// stands in for the comb's size and part of its significance, never for its separation
+    /// (`crate::learned::combine::decide`; [`diagnose`] never gives it). A probable fault at
+    /// most.
+    Agreed,
 }
 
 /// The strongest hypothesis and the strongest of the others once the leader is explained away.
@@ -378,7 +384,8 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
                 named: Some(Named::Alone),
             }
         }
-        None => {}
+        // Only the learned combination names by agreement.
+        Some(Named::Agreed) | None => {}
     }
     let (candidates, why) = if !rule.detected(best) {
         let what = if !rule.significant(best) {
@@ -411,18 +418,20 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
     }
 }
 
+/// Also the fixtures of the learned combination's tests (`crate::learned::combine`).
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::analysis::AnalysisSettings;
     use crate::bearing::BearingGeometry;
 
-    fn rule() -> DecisionRule {
+    pub(crate) fn rule() -> DecisionRule {
         AnalysisSettings::default().decision_rule()
     }
 
-    /// Scores in [`FaultKind::ALL`] order: (score, significance) each.
-    fn scores(values: [(f64, f64); 4]) -> Vec<FaultScore> {
+    /// Scores in [`FaultKind::ALL`] order: (score, significance) each, every harmonic at the
+    /// score (a consistent comb).
+    pub(crate) fn scores(values: [(f64, f64); 4]) -> Vec<FaultScore> {
         let freqs = BearingGeometry::from_catalog("skf-6205-2rs")
             .expect("a catalog bearing")
             .fault_frequencies(29.5);
