@@ -20,7 +20,7 @@
 
 use super::fault_bands::FaultScore;
 use crate::messages::FaultKind;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What the analysis concludes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -171,6 +171,37 @@ pub enum Named {
     /// (`crate::learned::combine::decide`; [`diagnose`] never gives it). A probable fault at
     /// most.
     Agreed,
+}
+
+/// How much less evidence the envelope needs for its first-ranked fault when the learned model
+/// names the same fault (`crate::learned::combine::decide`). The network stands in for the
+/// comb's size and for part of its significance, never for its separation from the runner-up
+/// nor for its shape. A parameter of the decision like [`DecisionRule`]; here, below the learned
+/// model, so that the analysis settings can hold it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Agreement {
+    /// The network's probability of the leader's class, at least.
+    pub min_probability: f64,
+    /// The leader's comb score, at least: below `min_fault_score` and `lone_fault_score`, the
+    /// point of the agreement.
+    pub min_score: f64,
+    /// The leader's score over the runner-up's once the leader is explained away (taken as at
+    /// least 1), at least; required whether the runner-up is detected or not.
+    pub min_lead: f64,
+    /// By how many decades the leader's significance may fall short of the rule's
+    /// (`min_significance`).
+    pub significance_relief_decades: f64,
+}
+
+impl Agreement {
+    /// No agreement counts: no probability reaches it, so `decide` gives the envelope's
+    /// diagnosis.
+    pub const OFF: Agreement = Agreement {
+        min_probability: f64::INFINITY,
+        min_score: f64::INFINITY,
+        min_lead: f64::INFINITY,
+        significance_relief_decades: 0.0,
+    };
 }
 
 /// The strongest hypothesis and the strongest of the others once the leader is explained away.

@@ -23,6 +23,7 @@
 //! is the envelope's diagnosis unchanged.
 
 use super::model::LearnedOpinion;
+pub use crate::analysis::diagnosis::Agreement;
 use crate::analysis::diagnosis::{
     Contest, DecisionRule, Diagnosis, Named, Verdict, LONE_HARMONIC_RATIO,
 };
@@ -154,62 +155,33 @@ pub fn combine(envelope: &EnvelopeView, learned: &LearnedOpinion) -> Combined {
     }
 }
 
-/// How much less evidence the envelope needs for its first-ranked fault when the learned model
-/// names the same fault ([`decide`]). The network stands in for the comb's size and for part of
-/// its significance, never for its separation from the runner-up nor for its shape.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Agreement {
-    /// The network's probability of the leader's class, at least (quantised to 10^-4 first, so
-    /// that the last bits of another CPU's arithmetic do not flip it at the boundary).
-    pub min_probability: f64,
-    /// The leader's comb score, at least: below `min_fault_score` and `lone_fault_score`, the
-    /// point of the agreement.
-    pub min_score: f64,
-    /// The leader's score over the runner-up's once the leader is explained away (taken as at
-    /// least 1), at least; required whether the runner-up is detected or not.
-    pub min_lead: f64,
-    /// By how many decades the leader's significance may fall short of the rule's
-    /// (`min_significance`).
-    pub significance_relief_decades: f64,
-}
-
-impl Agreement {
-    /// No agreement counts: no probability reaches it, so [`decide`] gives the envelope's
-    /// diagnosis.
-    pub const OFF: Agreement = Agreement {
-        min_probability: f64::INFINITY,
-        min_score: f64::INFINITY,
-        min_lead: f64::INFINITY,
-        significance_relief_decades: 0.0,
-    };
-
-    /// How far the leader clears the agreement's thresholds, in log units (positive: by the
-    /// factor `exp` of it on its weakest condition), the units of
-    /// [`DecisionRule::naming_margin`]; `None` when the network does not name the leader at
-    /// `min_probability`, or the leader is the cage (the network has no cage class), or its
-    /// harmonics do not stand.
-    fn margin(
-        &self,
-        contest: &Contest,
-        rule: &DecisionRule,
-        named: SimulatedFault,
-        p: f64,
-    ) -> Option<f64> {
-        let leader = contest.leader;
-        let sure = (p * 1e4).round() / 1e4 >= self.min_probability;
-        if !sure
-            || leader.fault == FaultKind::Cage
-            || named != SimulatedFault::of(leader.fault)
-            || !leader.harmonics_stand(LONE_HARMONIC_RATIO)
-        {
-            return None;
-        }
-        let needed = rule.min_significance() - self.significance_relief_decades;
-        let significance = (leader.significance - needed) * std::f64::consts::LN_10;
-        let size = (leader.score.max(1e-9) / self.min_score).ln();
-        let lead = (lead_ratio(contest) / self.min_lead).ln();
-        Some(significance.min(size).min(lead))
+/// How far the contest's leader clears `agreement`'s thresholds, in log units (positive: by the
+/// factor `exp` of it on its weakest condition), the units of [`DecisionRule::naming_margin`];
+/// `None` when the network (`named` at `p`) does not name the leader at `min_probability`, or
+/// the leader is the cage (the network has no cage class), or its harmonics do not stand. The
+/// probability is quantised to 10^-4 first, so that the last bits of another CPU's arithmetic
+/// do not flip it at the boundary.
+fn agreement_margin(
+    agreement: &Agreement,
+    contest: &Contest,
+    rule: &DecisionRule,
+    named: SimulatedFault,
+    p: f64,
+) -> Option<f64> {
+    let leader = contest.leader;
+    let sure = (p * 1e4).round() / 1e4 >= agreement.min_probability;
+    if !sure
+        || leader.fault == FaultKind::Cage
+        || named != SimulatedFault::of(leader.fault)
+        || !leader.harmonics_stand(LONE_HARMONIC_RATIO)
+    {
+        return None;
     }
+    let needed = rule.min_significance() - agreement.significance_relief_decades;
+    let significance = (leader.significance - needed) * std::f64::consts::LN_10;
+    let size = (leader.score.max(1e-9) / agreement.min_score).ln();
+    let lead = (lead_ratio(contest) / agreement.min_lead).ln();
+    Some(significance.min(size).min(lead))
 }
 
 /// The leader's score over the runner-up's (taken as at least 1).
@@ -245,9 +217,7 @@ pub fn decide(
         return diagnosis.clone();
     };
     let (class, p) = opinion.top();
-    let Some(margin) = agreement
-        .margin(&contest, rule, class, p)
-        .filter(|&m| m >= 0.0)
+    let Some(margin) = agreement_margin(agreement, &contest, rule, class, p).filter(|&m| m >= 0.0)
     else {
         return diagnosis.clone();
     };
