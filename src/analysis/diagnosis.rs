@@ -17,6 +17,8 @@
 //! leader is named when it is detected and no other hypothesis is detected on the evidence the
 //! leader does not explain, or the leader is `min_score_ratio` times stronger. Two detected,
 //! inseparable hypotheses give `none` with both named: a close call is said, never guessed.
+//! A third way of naming, a weaker leader the learned model names too ([`Named::Agreed`],
+//! parameters [`Agreement`]), is decided above the analysis, by `crate::learned::combine`.
 
 use super::fault_bands::FaultScore;
 use crate::messages::FaultKind;
