@@ -734,3 +734,66 @@ fn severity_names_the_machine_group_and_foundation_and_refuses_others() {
     );
     found.iter().for_each(assert_has_fix);
 }
+
+#[test]
+fn the_learned_agreement_is_off_unless_its_four_keys_are_given() {
+    use bearingd::analysis::diagnosis::Agreement;
+    assert_eq!(config_of(SENSOR).analysis.agreement, None);
+    let all = "[analysis]\nagreement_probability = 0.9\nagreement_fault_score = 3.0\n\
+               agreement_score_ratio = 2.0\nagreement_significance_relief = 1.0\n";
+    assert_eq!(
+        config_of(&format!("{SENSOR}{all}")).analysis.agreement,
+        Some(Agreement {
+            min_probability: 0.9,
+            min_score: 3.0,
+            min_lead: 2.0,
+            significance_relief_decades: 1.0,
+        })
+    );
+    // Half of them: the other two are missing, each with its fix.
+    let found = problems(&format!(
+        "{SENSOR}[analysis]\nagreement_probability = 0.9\nagreement_score_ratio = 2.0\n"
+    ));
+    assert_eq!(
+        keys(&found),
+        [
+            "analysis.agreement_fault_score",
+            "analysis.agreement_significance_relief"
+        ]
+    );
+    for problem in &found {
+        assert!(problem.message.starts_with("missing"), "{problem}");
+        assert_has_fix(problem);
+    }
+    // Out of range, or a relief that waives all of the significance false_alarm_rate asks
+    // (3 decades at 0.001).
+    for (key, bad) in [
+        ("agreement_probability", "0.3"),
+        ("agreement_score_ratio", "0.5"),
+        ("agreement_significance_relief", "3.0"),
+    ] {
+        let text = all.replace(&format!("{key} = "), &format!("{key} = {bad}\n# was "));
+        let found = problems(&format!("{SENSOR}{text}"));
+        assert_eq!(keys(&found), [format!("analysis.{key}")], "{found:?}");
+        assert_has_fix(&found[0]);
+    }
+}
+
+#[test]
+fn a_logged_config_from_before_the_agreement_reads_as_off() {
+    let mut logged = config_of(&format!(
+        "{SENSOR}[analysis]\nagreement_probability = 0.9\nagreement_fault_score = 3.0\n\
+         agreement_score_ratio = 2.0\nagreement_significance_relief = 1.0\n"
+    ));
+    let json = serde_json::to_string(&logged).unwrap();
+    assert_eq!(config::config_from_log(&json).unwrap(), logged);
+    // An older log's record has no `agreement` key at all.
+    let mut value: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let removed = value["analysis"]
+        .as_object_mut()
+        .and_then(|analysis| analysis.remove("agreement"));
+    assert!(removed.is_some(), "the logged analysis holds the agreement");
+    let older = config::config_from_log(&value.to_string()).unwrap();
+    logged.analysis.agreement = None;
+    assert_eq!(older, logged);
+}

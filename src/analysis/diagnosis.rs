@@ -17,10 +17,12 @@
 //! leader is named when it is detected and no other hypothesis is detected on the evidence the
 //! leader does not explain, or the leader is `min_score_ratio` times stronger. Two detected,
 //! inseparable hypotheses give `none` with both named: a close call is said, never guessed.
+//! A third way of naming, a weaker leader the learned model names too ([`Named::Agreed`],
+//! parameters [`Agreement`]), is decided above the analysis, by `crate::learned::combine`.
 
 use super::fault_bands::FaultScore;
 use crate::messages::FaultKind;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// What the analysis concludes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -152,11 +154,12 @@ impl DecisionRule {
     }
 }
 
-/// (choice) A comb named because it stands alone has every harmonic but one at least this many
-/// times its floor: on the simulator's machine (gear mesh, 100 Hz tone, shaft harmonics) the
-/// stray combs of healthy records at 0.6× speed reach 2–3 with two tall lines and three at the
-/// floor, while the weakest faults it should name show 2.7–3.8 on all five.
-const LONE_HARMONIC_RATIO: f64 = 2.0;
+/// (choice) A comb named because it stands alone (or with the learned model's agreement) has
+/// every harmonic but one at least this many times its floor: on the simulator's machine (gear
+/// mesh, 100 Hz tone, shaft harmonics) the stray combs of healthy records at 0.6× speed reach
+/// 2–3 with two tall lines and three at the floor, while the weakest faults it should name show
+/// 2.7–3.8 on all five.
+pub const LONE_HARMONIC_RATIO: f64 = 2.0;
 
 /// How the leader of a [`Contest`] was named.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -165,6 +168,42 @@ pub enum Named {
     BySize,
     /// A weaker comb with nothing near it (`lone_fault_score`, `lone_score_ratio`).
     Alone,
+    /// A weaker comb, clear of the runner-up, that the learned model names too: the network
+    /// stands in for the comb's size and part of its significance, never for its separation
+    /// (`crate::learned::combine::decide`; [`diagnose`] never gives it). A probable fault at
+    /// most.
+    Agreed,
+}
+
+/// How much less evidence the envelope needs for its first-ranked fault when the learned model
+/// names the same fault (`crate::learned::combine::decide`). The network stands in for the
+/// comb's size and for part of its significance, never for its separation from the runner-up
+/// nor for its shape. A parameter of the decision like [`DecisionRule`]; here, below the learned
+/// model, so that the analysis settings can hold it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Agreement {
+    /// The network's probability of the leader's class, at least.
+    pub min_probability: f64,
+    /// The leader's comb score, at least: below `min_fault_score` and `lone_fault_score`, the
+    /// point of the agreement.
+    pub min_score: f64,
+    /// The leader's score over the runner-up's once the leader is explained away (taken as at
+    /// least 1), at least; required whether the runner-up is detected or not.
+    pub min_lead: f64,
+    /// By how many decades the leader's significance may fall short of the rule's
+    /// (`min_significance`).
+    pub significance_relief_decades: f64,
+}
+
+impl Agreement {
+    /// No agreement counts: no probability reaches it, so `decide` gives the envelope's
+    /// diagnosis.
+    pub const OFF: Agreement = Agreement {
+        min_probability: f64::INFINITY,
+        min_score: f64::INFINITY,
+        min_lead: f64::INFINITY,
+        significance_relief_decades: 0.0,
+    };
 }
 
 /// The strongest hypothesis and the strongest of the others once the leader is explained away.
@@ -378,7 +417,8 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
                 named: Some(Named::Alone),
             }
         }
-        None => {}
+        // Only the learned combination names by agreement.
+        Some(Named::Agreed) | None => {}
     }
     let (candidates, why) = if !rule.detected(best) {
         let what = if !rule.significant(best) {
@@ -411,18 +451,20 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
     }
 }
 
+/// Also the fixtures of the learned combination's tests (`crate::learned::combine`).
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::analysis::AnalysisSettings;
     use crate::bearing::BearingGeometry;
 
-    fn rule() -> DecisionRule {
+    pub(crate) fn rule() -> DecisionRule {
         AnalysisSettings::default().decision_rule()
     }
 
-    /// Scores in [`FaultKind::ALL`] order: (score, significance) each.
-    fn scores(values: [(f64, f64); 4]) -> Vec<FaultScore> {
+    /// Scores in [`FaultKind::ALL`] order: (score, significance) each, every harmonic at the
+    /// score (a consistent comb).
+    pub(crate) fn scores(values: [(f64, f64); 4]) -> Vec<FaultScore> {
         let freqs = BearingGeometry::from_catalog("skf-6205-2rs")
             .expect("a catalog bearing")
             .fault_frequencies(29.5);

@@ -1,6 +1,7 @@
 //! Settings of the analysis core, already validated. The config module builds them from TOML,
 //! `analyze` from its command line; the core never parses text itself.
 
+use super::diagnosis::Agreement;
 use serde::{Deserialize, Serialize};
 
 /// How the resonance band for envelope analysis is chosen (MODELS.md §3).
@@ -50,6 +51,11 @@ pub struct AnalysisSettings {
     /// ...this many times every other hypothesis once it is explained away, and significant
     /// at `false_alarm_rate²`.
     pub lone_score_ratio: f64,
+    /// How much less evidence a first-ranked fault needs when the learned model names it too
+    /// (`crate::learned::combine::decide`). `None`, the default, is off (its parameters are not
+    /// calibrated yet); logs written before it existed read as off.
+    #[serde(default)]
+    pub agreement: Option<Agreement>,
 }
 
 impl AnalysisSettings {
@@ -81,6 +87,7 @@ impl Default for AnalysisSettings {
             min_score_ratio: 1.5,
             lone_fault_score: 2.5,
             lone_score_ratio: 2.0,
+            agreement: None,
         }
     }
 }

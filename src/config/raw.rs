@@ -136,6 +136,10 @@ pub(crate) struct RawAnalysis {
     pub min_score_ratio: Field<f64>,
     pub lone_fault_score: Field<f64>,
     pub lone_score_ratio: Field<f64>,
+    pub agreement_probability: Field<f64>,
+    pub agreement_fault_score: Field<f64>,
+    pub agreement_score_ratio: Field<f64>,
+    pub agreement_significance_relief: Field<f64>,
 }
 
 #[derive(Debug, Default, Deserialize)]

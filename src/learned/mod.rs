@@ -8,7 +8,8 @@
 //! - [`network`]: the autoencoder and the classifier;
 //! - [`model`]: a trained model file (weights + model card) and its opinion of a record;
 //! - [`train`]: training on a data set, seeded;
-//! - [`combine`]: the decision rule with the envelope diagnosis.
+//! - [`combine`]: the decision rule with the envelope diagnosis (`combine`, used today, and
+//!   `decide`, the rule with the learned model's agreement meant to replace it, not called yet).
 
 pub mod combine;
 pub mod features;

@@ -1,6 +1,7 @@
 //! `[analysis]`: window, hop, band selection and fixed bands, checked against the sensors' rates.
 
 use super::*;
+use crate::analysis::diagnosis::Agreement;
 
 /// (choice) The longest evidence horizon: a channel keeps its horizon as 16-bit counts, 2 bytes
 /// per sample (10 minutes at 25.6 kHz: 31 MB per channel).
@@ -118,6 +119,7 @@ impl Checker {
             "give how many times every other fault a comb below min_fault_score must be to \
              stand alone, at least 1, e.g. lone_score_ratio = 2.0",
         );
+        let agreement = self.agreement(raw, false_alarm_rate);
         Some((
             AnalysisSettings {
                 window_s: window_s?,
@@ -133,10 +135,93 @@ impl Checker {
                 min_score_ratio: min_score_ratio?,
                 lone_fault_score: lone_fault_score?,
                 lone_score_ratio: lone_score_ratio?,
+                agreement: agreement?,
             },
             band_period_s?,
             evidence_horizon_s?,
         ))
+    }
+
+    /// The learned model's agreement (`analysis.agreement_*`): off unless given, and then all
+    /// four keys, for none has a calibrated default yet.
+    fn agreement(
+        &mut self,
+        raw: &RawAnalysis,
+        false_alarm_rate: Option<f64>,
+    ) -> Option<Option<Agreement>> {
+        let keys: [(&str, &Field<f64>, Limits, &str); 4] = [
+            (
+                "analysis.agreement_probability",
+                &raw.agreement_probability,
+                Limits::within(0.5, 1.0),
+                "give how sure the learned model must be of the envelope's first-ranked fault, \
+                 0.5 to 1, e.g. agreement_probability = 0.9",
+            ),
+            (
+                "analysis.agreement_fault_score",
+                &raw.agreement_fault_score,
+                Limits::within(1.0, f64::INFINITY),
+                "give the smallest comb score (at least 1) the first-ranked fault needs when the \
+                 learned model names it too, e.g. agreement_fault_score = 3.0",
+            ),
+            (
+                "analysis.agreement_score_ratio",
+                &raw.agreement_score_ratio,
+                Limits::within(1.0, f64::INFINITY),
+                "give how many times every other fault, once it is explained away, an agreed \
+                 fault must be, at least 1, e.g. agreement_score_ratio = 2.0",
+            ),
+            (
+                "analysis.agreement_significance_relief",
+                &raw.agreement_significance_relief,
+                Limits::within(0.0, f64::INFINITY),
+                "give by how many decades an agreed fault's significance may fall short of \
+                 false_alarm_rate's, 0 or more, e.g. agreement_significance_relief = 1.0",
+            ),
+        ];
+        let mut values = [None; 4];
+        let mut missing = Vec::new();
+        for (value, &(key, field, limits, fix)) in values.iter_mut().zip(&keys) {
+            match self.get(key, field, fix) {
+                Got::Missing => missing.push((key, fix)),
+                Got::Invalid => {}
+                Got::Value(v) => *value = self.in_limits(key, v, limits, fix),
+            }
+        }
+        if missing.len() == keys.len() {
+            return Some(None);
+        }
+        for (key, fix) in missing {
+            self.problem(
+                key,
+                format!(
+                    "missing: the learned model's agreement has no defaults yet, so its four \
+                     keys go together; {fix}, or remove the other agreement_* keys"
+                ),
+            );
+        }
+        let [Some(min_probability), Some(min_score), Some(min_lead), Some(relief)] = values else {
+            return None;
+        };
+        // A relief of the whole significance would name what noise gives at any probability.
+        let needed = -false_alarm_rate?.log10();
+        if relief >= needed {
+            self.problem(
+                "analysis.agreement_significance_relief",
+                format!(
+                    "{relief} decades would waive all of the {needed:.1} that false_alarm_rate \
+                     asks, so noise could be named; lower it below {needed:.1}, e.g. \
+                     agreement_significance_relief = 1.0"
+                ),
+            );
+            return None;
+        }
+        Some(Some(Agreement {
+            min_probability,
+            min_score,
+            min_lead,
+            significance_relief_decades: relief,
+        }))
     }
 
     pub(super) fn band_selection(
