@@ -53,7 +53,7 @@ fn main() {
             _ => None,
         })
         .collect();
-    let mut pipeline = Pipeline::new(&config, &BTreeMap::new());
+    let mut pipeline = Pipeline::new(&config, &BTreeMap::new(), None);
     let (mut quiet, mut window, mut to_flag, mut deciding) = (vec![], vec![], vec![], vec![]);
     for _ in 0..seconds * 10 {
         for source in &mut sources {

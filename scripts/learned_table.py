@@ -127,7 +127,7 @@ def main():
     print("## Synthetic test set (config/learned-test.toml: weaker faults, another seed)\n")
     print(f"{len(cases)} records the model never trained on, each analysed from its MCAP log.\n")
     print_comparison(cases)
-    confirmed = [c for c in cases if c["basis"] == "envelope_confirmed_by_learned"]
+    confirmed = [c for c in cases if c["basis"] == "agreement"]
     print(f"The network settled {len(confirmed)} records the envelope left open; "
           f"{sum(c['combined'] == c['truth'] for c in confirmed)} of them right.")
 

@@ -11,7 +11,7 @@ use crate::analysis::iso::{record_severity, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
 use crate::bearing::{BearingError, BearingGeometry};
-use crate::learned::{combine as combine_learned, EnvelopeView, LearnedModel, ModelError};
+use crate::learned::{combined as combined_with_learned, LearnedModel, ModelError};
 use crate::messages::FaultKind;
 use crate::recording::{read_recording, ReadOptions, Recording, RecordingError, RecordingFormat};
 use crate::report::{AnalyzeReport, RecordContext, SpeedSource, TwinReport};
@@ -36,7 +36,7 @@ pub struct AnalyzeRequest {
     /// The machine group and foundation the ISO 10816-3 velocity zones are judged for.
     pub severity: SeveritySettings,
     /// A learned model's second opinion, combined with the envelope diagnosis
-    /// (`analyze --learned`; see [`crate::learned::combine`]).
+    /// (`analyze --learned`): the second witness of [`crate::analysis::agreement::decide`].
     pub learned: Option<std::sync::Arc<LearnedModel>>,
 }
 
@@ -308,12 +308,28 @@ pub fn analyze_recording(
     let file = recording.path.display().to_string();
     let freqs = bearing.fault_frequencies(rpm / 60.0);
     let samples: Vec<f32> = recording.samples.iter().map(|&x| x as f32).collect();
-    let analysis = analyzer
+    let mut analysis = analyzer
         .analyze(&samples, fs_hz, &freqs, &request.settings)
         .map_err(|source| OfflineError::Analysis {
             file: file.clone(),
             source,
         })?;
+    // The learned model is the second witness of the same samples: the verdict hears it
+    // before the report is made from it, so the report shows the band of what it names.
+    let envelope_verdict = analysis.diagnosis.verdict;
+    let learned = match &request.learned {
+        Some(model) => {
+            let opinion = model
+                .opinion(&samples, fs_hz, rpm / 60.0, &bearing)
+                .map_err(|source| OfflineError::Learned {
+                    file: file.clone(),
+                    source,
+                })?;
+            analysis.hear_witness(opinion.as_witness(), &request.settings);
+            Some((model, opinion))
+        }
+        None => None,
+    };
     let context = RecordContext {
         file,
         channel: recording.channel.clone(),
@@ -360,21 +376,7 @@ pub fn analyze_recording(
         report.set_twin(TwinReport::new(&twin, fit_ms, agrees, note), &combined);
         twin
     });
-    let mut verdict = analysis.diagnosis.verdict;
-    if let Some(model) = &request.learned {
-        let opinion = model
-            .opinion(&samples, fs_hz, rpm / 60.0, &report.bearing_geometry)
-            .map_err(|source| OfflineError::Learned {
-                file: report.file.clone(),
-                source,
-            })?;
-        let view = EnvelopeView::of(
-            &analysis.diagnosis,
-            analysis.hypotheses.iter().map(|h| &h.score),
-            &request.settings.decision_rule(),
-        );
-        let combined = combine_learned(&view, &opinion);
-        verdict = combined.verdict;
+    if let Some((model, opinion)) = learned {
         if opinion.segments == 0 {
             let segment = model.card.features.segment_revolutions;
             report.warnings.push(format!(
@@ -382,8 +384,10 @@ pub fn analyze_recording(
                 segment * 60.0 / rpm
             ));
         }
-        report.set_learned(opinion, combined);
+        let combined = combined_with_learned(&analysis.diagnosis, &opinion);
+        report.set_learned(opinion, combined, envelope_verdict);
     }
+    let verdict = analysis.diagnosis.verdict;
     // After the verdict is final: only a named race fault is sized. Not in the daemon's
     // per-window path: it needs the whole record's impacts.
     report.set_defect_size(measure_for_verdict(

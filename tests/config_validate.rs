@@ -735,14 +735,25 @@ fn severity_names_the_machine_group_and_foundation_and_refuses_others() {
     found.iter().for_each(assert_has_fix);
 }
 
+/// The learned model the agreement's tests give as the witness (the shipped one).
+fn witness() -> String {
+    format!(
+        "[twin]\nlearned_model = \"{}/models/skf-6205-2rs.safetensors\"\n",
+        env!("CARGO_MANIFEST_DIR")
+    )
+}
+
 #[test]
 fn the_learned_agreement_is_off_unless_its_four_keys_are_given() {
-    use bearingd::analysis::diagnosis::Agreement;
+    use bearingd::analysis::agreement::Agreement;
     assert_eq!(config_of(SENSOR).analysis.agreement, None);
     let all = "[analysis]\nagreement_probability = 0.9\nagreement_fault_score = 3.0\n\
                agreement_score_ratio = 2.0\nagreement_significance_relief = 1.0\n";
+    let witness = witness();
     assert_eq!(
-        config_of(&format!("{SENSOR}{all}")).analysis.agreement,
+        config_of(&format!("{SENSOR}{all}{witness}"))
+            .analysis
+            .agreement,
         Some(Agreement {
             min_probability: 0.9,
             min_score: 3.0,
@@ -773,17 +784,31 @@ fn the_learned_agreement_is_off_unless_its_four_keys_are_given() {
         ("agreement_significance_relief", "3.0"),
     ] {
         let text = all.replace(&format!("{key} = "), &format!("{key} = {bad}\n# was "));
-        let found = problems(&format!("{SENSOR}{text}"));
+        let found = problems(&format!("{SENSOR}{text}{witness}"));
         assert_eq!(keys(&found), [format!("analysis.{key}")], "{found:?}");
         assert_has_fix(&found[0]);
     }
+    // All four without a model to agree with: refused, naming the key that gives one.
+    let found = problems(&format!("{SENSOR}{all}"));
+    assert_eq!(
+        keys(&found),
+        ["analysis.agreement_probability"],
+        "{found:?}"
+    );
+    assert!(
+        found[0].message.contains("twin.learned_model"),
+        "{}",
+        found[0]
+    );
+    assert_has_fix(&found[0]);
 }
 
 #[test]
 fn a_logged_config_from_before_the_agreement_reads_as_off() {
     let mut logged = config_of(&format!(
         "{SENSOR}[analysis]\nagreement_probability = 0.9\nagreement_fault_score = 3.0\n\
-         agreement_score_ratio = 2.0\nagreement_significance_relief = 1.0\n"
+         agreement_score_ratio = 2.0\nagreement_significance_relief = 1.0\n{}",
+        witness()
     ));
     let json = serde_json::to_string(&logged).unwrap();
     assert_eq!(config::config_from_log(&json).unwrap(), logged);

@@ -13,11 +13,12 @@
 //! a delay in samples, and waits for it there if it is late. So the result takes effect at the
 //! same sample whatever thread ran it and however long it took: a replay repeats every event.
 
+use super::agreement::{Witness, WitnessOpinion};
 use super::diagnosis::{Named, Verdict};
 use super::envelope::FftPlans;
 use super::fault_bands::FaultScore;
 use super::monitor::SpeedMode;
-use super::record::analyze_with_plans;
+use super::record::{analyze_with_plans, RecordAnalysis};
 use super::speed::estimate_shaft_hz;
 use super::{AnalysisSettings, Band};
 use crate::bearing::FaultFrequencies;
@@ -43,6 +44,8 @@ pub struct BandJob {
     pub max_shaft_hz: f64,
     pub speed: SpeedMode,
     pub analysis: AnalysisSettings,
+    /// The second witness the verdict hears, when `analysis.agreement` is set.
+    pub witness: Option<Arc<dyn Witness>>,
 }
 
 /// What a band selection found.
@@ -66,8 +69,20 @@ pub struct Evidence {
     /// The verdict (its faults are the ones whose flags it raises) and how it was named.
     pub verdict: Verdict,
     pub named: Option<Named>,
+    /// What the second witness said, when it was asked.
+    pub witness: Option<WitnessHeard>,
     /// Samples the history held.
     pub samples: usize,
+}
+
+/// What a second witness said of a band job's history.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum WitnessHeard {
+    Opinion(WitnessOpinion),
+    /// It had nothing to say (the history is shorter than it needs).
+    Silent,
+    /// It failed; the verdict is the envelope's.
+    Failed,
 }
 
 impl Evidence {
@@ -90,7 +105,20 @@ impl Evidence {
                 )
             })
             .collect();
-        format!("verdict on {seconds:.1} s: {said} ({})", scores.join(", "))
+        let witness = match self.witness {
+            None => String::new(),
+            Some(WitnessHeard::Opinion(o)) => format!(
+                "; the witness says {} ({:.0} %)",
+                o.fault.map_or("none", FaultKind::name),
+                100.0 * o.probability
+            ),
+            Some(WitnessHeard::Silent) => "; the witness has no opinion (too short)".into(),
+            Some(WitnessHeard::Failed) => "; the witness failed".into(),
+        };
+        format!(
+            "verdict on {seconds:.1} s: {said} ({}){witness}",
+            scores.join(", ")
+        )
     }
 
     /// The largest score of the faults other than `fault` (at least 1e-9).
@@ -151,7 +179,9 @@ impl BandJob {
                 evidence: None,
             };
         }
-        let analysis = analyze_with_plans(plans, &signal, self.fs_hz, &freqs, &self.analysis).ok();
+        let mut analysis =
+            analyze_with_plans(plans, &signal, self.fs_hz, &freqs, &self.analysis).ok();
+        let witness = self.hear_witness(analysis.as_mut(), &signal, freqs.shaft);
         let evidence = analysis.as_ref().map(|analysis| Evidence {
             scores: FaultKind::ALL.map(|kind| {
                 analysis
@@ -162,6 +192,7 @@ impl BandJob {
             }),
             verdict: analysis.diagnosis.verdict,
             named: analysis.diagnosis.named,
+            witness,
             samples: signal.len(),
         });
         let bands = analysis.map(|analysis| {
@@ -181,6 +212,34 @@ impl BandJob {
             bands,
             evidence,
         }
+    }
+}
+
+impl BandJob {
+    /// Asks the witness (when there is one and an agreement to weigh it by) of `signal`, and
+    /// lets the analysis's verdict hear it.
+    fn hear_witness(
+        &self,
+        analysis: Option<&mut RecordAnalysis>,
+        signal: &[f32],
+        shaft_hz: f64,
+    ) -> Option<WitnessHeard> {
+        let (Some(analysis), Some(witness), Some(_)) =
+            (analysis, &self.witness, self.analysis.agreement)
+        else {
+            return None;
+        };
+        let heard = match witness.witness(signal, self.fs_hz, shaft_hz) {
+            Ok(Some(opinion)) => WitnessHeard::Opinion(opinion),
+            Ok(None) => WitnessHeard::Silent,
+            Err(_) => WitnessHeard::Failed,
+        };
+        let opinion = match heard {
+            WitnessHeard::Opinion(opinion) => Some(opinion),
+            _ => None,
+        };
+        analysis.hear_witness(opinion, &self.analysis);
+        Some(heard)
     }
 }
 

@@ -17,12 +17,12 @@
 //! leader is named when it is detected and no other hypothesis is detected on the evidence the
 //! leader does not explain, or the leader is `min_score_ratio` times stronger. Two detected,
 //! inseparable hypotheses give `none` with both named: a close call is said, never guessed.
-//! A third way of naming, a weaker leader the learned model names too ([`Named::Agreed`],
-//! parameters [`Agreement`]), is decided above the analysis, by `crate::learned::combine`.
+//! A third way of naming, a weaker leader a second witness (the learned model) names too
+//! ([`Named::Agreed`]), is decided after this rule, by [`super::agreement::decide`].
 
 use super::fault_bands::FaultScore;
 use crate::messages::FaultKind;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 /// What the analysis concludes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -170,40 +170,8 @@ pub enum Named {
     Alone,
     /// A weaker comb, clear of the runner-up, that the learned model names too: the network
     /// stands in for the comb's size and part of its significance, never for its separation
-    /// (`crate::learned::combine::decide`; [`diagnose`] never gives it). A probable fault at
-    /// most.
+    /// ([`super::agreement::decide`]; [`diagnose`] never gives it). A probable fault at most.
     Agreed,
-}
-
-/// How much less evidence the envelope needs for its first-ranked fault when the learned model
-/// names the same fault (`crate::learned::combine::decide`). The network stands in for the
-/// comb's size and for part of its significance, never for its separation from the runner-up
-/// nor for its shape. A parameter of the decision like [`DecisionRule`]; here, below the learned
-/// model, so that the analysis settings can hold it.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Agreement {
-    /// The network's probability of the leader's class, at least.
-    pub min_probability: f64,
-    /// The leader's comb score, at least: below `min_fault_score` and `lone_fault_score`, the
-    /// point of the agreement.
-    pub min_score: f64,
-    /// The leader's score over the runner-up's once the leader is explained away (taken as at
-    /// least 1), at least; required whether the runner-up is detected or not.
-    pub min_lead: f64,
-    /// By how many decades the leader's significance may fall short of the rule's
-    /// (`min_significance`).
-    pub significance_relief_decades: f64,
-}
-
-impl Agreement {
-    /// No agreement counts: no probability reaches it, so `decide` gives the envelope's
-    /// diagnosis.
-    pub const OFF: Agreement = Agreement {
-        min_probability: f64::INFINITY,
-        min_score: f64::INFINITY,
-        min_lead: f64::INFINITY,
-        significance_relief_decades: 0.0,
-    };
 }
 
 /// The strongest hypothesis and the strongest of the others once the leader is explained away.
@@ -451,7 +419,7 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
     }
 }
 
-/// Also the fixtures of the learned combination's tests (`crate::learned::combine`).
+/// Also the fixtures of the agreement's tests (`super::agreement`).
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;

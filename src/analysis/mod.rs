@@ -17,6 +17,7 @@
 //! - [`degradation`]: the trend of RMS over life with its time to the failure limit (a life
 //!   of snapshots is walked by `offline::life`, which also needs the twin).
 
+pub mod agreement;
 pub mod band;
 pub mod band_search;
 pub mod band_selection;

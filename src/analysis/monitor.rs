@@ -46,6 +46,7 @@
 //!
 //! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
 
+use super::agreement::Witness;
 use super::band_selection::Evidence;
 use super::band_selection::{
     scaled, usable_shaft_hz, BandJob, BandResult, BandSelector, InlineSelector,
@@ -272,6 +273,10 @@ pub struct ChannelMonitor {
     last_count: Option<i32>,
     /// Runs the band selections ([`InlineSelector`] unless given one).
     band_selector: Box<dyn BandSelector>,
+    /// The fault the latest verdict the flags followed named by agreement with the witness.
+    agreed: Option<FaultKind>,
+    /// The second witness the band jobs' verdicts hear ([`super::agreement`]); `None`: none.
+    witness: Option<std::sync::Arc<dyn Witness>>,
     /// Samples from a band selection's start to the sample where its result is used.
     band_delay_samples: u64,
     /// Where the band selection under way (if any) is used.
@@ -387,6 +392,8 @@ impl ChannelMonitor {
             flat_since: 0,
             last_count: None,
             band_selector: Box::new(InlineSelector::default()),
+            witness: None,
+            agreed: None,
             band_delay_samples: 0,
             band_result_at: None,
             band_job_from: 0,
@@ -414,6 +421,13 @@ impl ChannelMonitor {
         self.band_selector = selector;
         self.band_delay_samples = delay_samples;
         self.next_band_selection += first_extra_samples;
+        self
+    }
+
+    /// The monitor with a second witness its verdicts hear (the learned model), by
+    /// `analysis.agreement` ([`super::agreement::decide`]).
+    pub fn with_witness(mut self, witness: std::sync::Arc<dyn Witness>) -> Self {
+        self.witness = Some(witness);
         self
     }
 
@@ -483,6 +497,12 @@ impl ChannelMonitor {
 
     pub fn bands(&self) -> Option<&[Band; 4]> {
         self.bands_known.then_some(&self.bands)
+    }
+
+    /// The fault the latest verdict the flags followed named by agreement with the second
+    /// witness ([`super::diagnosis::Named::Agreed`]), if it did.
+    pub fn agreed_fault(&self) -> Option<FaultKind> {
+        self.agreed
     }
 
     /// The latest window's fault scores, in [`FaultKind::ALL`] order.
@@ -728,6 +748,7 @@ impl ChannelMonitor {
             max_shaft_hz: self.settings.speed.max_shaft_hz(self.freqs.shaft),
             speed: self.settings.speed,
             analysis: self.settings.analysis.clone(),
+            witness: self.witness.clone(),
         }));
         self.band_result_at = Some(self.next_sample + self.band_delay_samples);
         if self.band_delay_samples == 0 {
@@ -780,6 +801,10 @@ impl ChannelMonitor {
     fn follow_evidence(&mut self, evidence: &Evidence, on_event: &mut impl FnMut(MonitorEvent)) {
         let at = self.next_sample;
         let from = self.band_job_from;
+        self.agreed = evidence
+            .verdict
+            .fault()
+            .filter(|_| evidence.named == Some(super::diagnosis::Named::Agreed));
         for (i, kind) in FaultKind::ALL.iter().enumerate() {
             let score = &evidence.scores[i];
             let asked = if evidence.named.is_some() && evidence.verdict.faults().contains(kind) {

@@ -6,6 +6,7 @@
 //! its significance then pays for that search ([`super::band_search`]). Band selection can
 //! thereby only add evidence, never cut it away.
 
+use super::agreement::{decide, WitnessOpinion};
 use super::band::Band;
 use super::band_search::{candidate_bands, search_significance};
 use super::diagnosis::{diagnose, leader, Diagnosis};
@@ -99,6 +100,38 @@ impl RecordAnalysis {
             .find(|h| h.score.fault == kind)
             .map_or(0.0, |h| h.score.score)
     }
+
+    /// Every hypothesis's score in its best band, in [`FaultKind::ALL`] order.
+    pub fn scores(&self) -> Vec<FaultScore> {
+        self.hypotheses.iter().map(|h| h.score).collect()
+    }
+
+    /// The verdict once a second witness (`opinion`, of the same samples) is heard, by
+    /// [`decide`] with `settings.agreement` (none: the envelope's verdict stands).
+    pub fn hear_witness(&mut self, opinion: Option<WitnessOpinion>, settings: &AnalysisSettings) {
+        let Some(agreement) = settings.agreement else {
+            return;
+        };
+        self.diagnosis = decide(
+            &self.scores(),
+            &self.explained,
+            &self.diagnosis,
+            &settings.decision_rule(),
+            &agreement,
+            opinion,
+        );
+        self.reported_band_index =
+            reported_band(&self.hypotheses, &self.diagnosis, self.selected_band_index);
+    }
+}
+
+/// The band behind a verdict: the named fault's band, else the selected band.
+fn reported_band(hypotheses: &[Hypothesis], diagnosis: &Diagnosis, selected: usize) -> usize {
+    diagnosis
+        .verdict
+        .fault()
+        .and_then(|kind| hypotheses.iter().find(|h| h.score.fault == kind))
+        .map_or(selected, |h| h.band_index)
 }
 
 /// The highest envelope frequency the scores need: the last harmonic of the highest fault
@@ -280,11 +313,7 @@ pub fn analyze_with_plans(
             None => Vec::new(),
         };
         let diagnosis = diagnose(&scores, &explained, &rule);
-        let reported_band_index = diagnosis
-            .verdict
-            .fault()
-            .and_then(|kind| hypotheses.iter().find(|h| h.score.fault == kind))
-            .map_or(selected_band_index, |h| h.band_index);
+        let reported_band_index = reported_band(&hypotheses, &diagnosis, selected_band_index);
 
         Ok(RecordAnalysis {
             fs_hz,

@@ -1,7 +1,7 @@
 //! Settings of the analysis core, already validated. The config module builds them from TOML,
 //! `analyze` from its command line; the core never parses text itself.
 
-use super::diagnosis::Agreement;
+use super::agreement::Agreement;
 use serde::{Deserialize, Serialize};
 
 /// How the resonance band for envelope analysis is chosen (MODELS.md §3).
@@ -52,7 +52,7 @@ pub struct AnalysisSettings {
     /// at `false_alarm_rate²`.
     pub lone_score_ratio: f64,
     /// How much less evidence a first-ranked fault needs when the learned model names it too
-    /// (`crate::learned::combine::decide`). `None`, the default, is off (its parameters are not
+    /// ([`super::agreement::decide`]). `None`, the default, is off (its parameters are not
     /// calibrated yet); logs written before it existed read as off.
     #[serde(default)]
     pub agreement: Option<Agreement>,

@@ -9,8 +9,8 @@ use crate::evaluate::false_alarms::{
     RunResult,
 };
 use crate::evaluate::recordings::{
-    evaluate_recordings, plan, render_recordings, tally, Entry, Manifest, RecordingsOptions,
-    RecordingsReport, Said,
+    evaluate_recordings, plan, render_recordings, tally, Entry, Manifest, RecordingsAgreement,
+    RecordingsOptions, RecordingsReport, Said,
 };
 use crate::evaluate::{
     in_order, pd_figure, render_csv, render_tables, run_sweep, summarize, Bench,
@@ -68,7 +68,10 @@ pub struct EvaluateArgs {
     #[arg(long)]
     jobs: Option<usize>,
     /// Take the analysis and threshold settings from this config file instead of the
-    /// embedded default (to evaluate a tuned configuration).
+    /// embedded default (to evaluate a tuned configuration). With `twin.learned_model` the
+    /// sweep's record path also writes agreement_grid.txt (the learned model's agreement
+    /// decided at every point of a parameter grid); with --recordings only its agreement_*
+    /// keys and model are used, by both paths.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Leave out the machine's nuisance (shaft harmonics, modulated noise, random impulses,
@@ -139,11 +142,16 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
         runs: &results,
     })
     .map_err(|e| CliError::failure(format!("cannot encode the results as JSON: {e}")))?;
-    let written = [
+    let mut written = vec![
         write("results.json", &json)?,
         write("results.csv", render_csv(&results).as_bytes())?,
         write("table.txt", tables.as_bytes())?,
     ];
+    if bench.witness.is_some() {
+        let grid = crate::evaluate::agreement::render(&results);
+        print!("\n{grid}");
+        written.push(write("agreement_grid.txt", grid.as_bytes())?);
+    }
     let plot_path = args.out.join("pd_vs_snr.svg");
     crate::plot::save(&pd_figure(&summary, &sweep.name), &plot_path)
         .map_err(|e| CliError::failure(e.to_string()))?;
@@ -164,9 +172,9 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
 /// The embedded default config, or `--config`'s.
 fn bench(args: &EvaluateArgs) -> Result<Bench, CliError> {
     match &args.config {
-        Some(path) => Ok(Bench {
-            config: crate::config::load(path).map_err(CliError::input)?,
-        }),
+        Some(path) => {
+            Bench::new(crate::config::load(path).map_err(CliError::input)?).map_err(CliError::input)
+        }
         None => Bench::embedded().map_err(CliError::failure),
     }
 }
@@ -344,10 +352,16 @@ fn run_recordings(args: &EvaluateArgs) -> Result<(), CliError> {
         .map(|path| Manifest::read(path).map_err(CliError::input))
         .collect::<Result<Vec<_>, _>>()?;
     create_out(&args.out)?;
+    let agreement = match &args.config {
+        Some(path) => RecordingsAgreement::of(&crate::config::load(path).map_err(CliError::input)?)
+            .map_err(CliError::input)?,
+        None => None,
+    };
     let options = RecordingsOptions {
         all_channels: args.all_channels,
         jobs: threads(args)?,
         scratch: args.out.clone(),
+        agreement,
     };
     let tasks = plan(&manifests, options.all_channels);
     eprintln!(

@@ -22,15 +22,18 @@
 //! recording ends on `analyze`'s verdict of the same samples.
 
 use super::events::{DaemonEvent, Events};
+use crate::analysis::agreement::Witness;
 use crate::analysis::health::{baselines_from_json, Baseline};
 use crate::config::Config;
 use crate::mcap_log::ReadSummary;
 use crate::messages::{ChannelId, FlagMessage, PipelineMessage};
+use crate::pipeline::load_learned;
 use crate::pipeline::{Input, Output, Pipeline, Sink, SinkError, TwinWorker};
 use crate::sources::replay::plan::{PlannedRun, ReplayPlan};
 use crate::sources::replay::ReplaySource;
 use std::collections::{BTreeMap, HashMap};
 use std::path::PathBuf;
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 /// How to replay.
@@ -219,8 +222,13 @@ impl<'a> RunReplay<'a> {
         (baselines_from, start_baselines): (BaselinesFrom, BTreeMap<ChannelId, Baseline>),
         options: &ReplayOptions,
     ) -> Result<Self, ReplayError> {
-        let worker = TwinWorker::new(&config.twin)?;
-        let pipeline = Pipeline::new(config, &start_baselines);
+        let learned = load_learned(&config.twin)?;
+        let pipeline = Pipeline::new(
+            config,
+            &start_baselines,
+            learned.clone().map(|m| m as Arc<dyn Witness>),
+        );
+        let worker = TwinWorker::new(&config.twin, learned);
         let paths = plan.paths(run);
         let source = ReplaySource::open(
             &paths,

@@ -41,11 +41,13 @@ use super::cpu_latency::{CpuLatencyCap, CPU_LATENCY_DEVICE};
 use super::events::{DaemonEvent, Events};
 use super::lock::{DirLock, LockError};
 use super::state::{load_baselines, save_baselines};
+use crate::analysis::agreement::Witness;
 use crate::analysis::health::Baseline;
 use crate::clock::wall_clock_now_ns;
 use crate::config::{Config, Transport};
 use crate::mcap_log::McapLogError;
 use crate::messages::{ChannelId, FlagMessage, PipelineMessage};
+use crate::pipeline::load_learned;
 use crate::pipeline::twin_queue::{twin_requests, TwinRequestQueue, TwinRequests};
 use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinWorker};
 use crate::sinks::alerts::PublisherSummary;
@@ -59,7 +61,7 @@ use crate::sources::sim::SimSource;
 use crate::sources::Arrived;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::mpsc;
+use std::sync::{mpsc, Arc};
 use std::time::Duration;
 use tokio::sync::{mpsc as async_mpsc, watch};
 use tokio::task::JoinSet;
@@ -161,7 +163,12 @@ pub async fn run(
     }
     let alerts = start_alerts(&config, &events)?;
     let _cpu_latency = cap_cpu_latency(&config, &events);
-    let pipeline = Pipeline::new(&config, &baselines);
+    let learned = load_learned(&config.twin)?;
+    let pipeline = Pipeline::new(
+        &config,
+        &baselines,
+        learned.clone().map(|m| m as Arc<dyn Witness>),
+    );
 
     let (input_tx, input_rx) = async_mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
     let (sink_tx, sink_rx) = mpsc::sync_channel::<PipelineMessage>(SINK_QUEUE);
@@ -171,7 +178,7 @@ pub async fn run(
     let (status_tx, status_rx) = watch::channel(pipeline.status());
 
     let sink = spawn("sink", move || sink_thread(sinks, &sink_rx))?;
-    let worker = TwinWorker::new(&config.twin)?;
+    let worker = TwinWorker::new(&config.twin, learned);
     let refit = spawn("twin", move || refit_thread(worker, &request_rx, &fit_tx))?;
     let analysis = AnalysisThread {
         pipeline,

@@ -16,7 +16,10 @@
 //! threads share. With no rise in T hours the rate's 95 % upper bound is 3.0/T (Poisson:
 //! e^(-λT) = 0.05); with k rises, the exact Poisson bound ([`poisson_upper_95`]).
 
-use super::run::{to_counts, Bench, CaseSignal, FlagRise, MonitorWatch, StrongestEvidence, BLOCK};
+use super::run::{
+    to_counts, witnessed_monitor, Bench, CaseSignal, FlagRise, MonitorWatch, StrongestEvidence,
+    BLOCK,
+};
 use super::sweep::{Case, Machine, NoiseLevel, Sweep};
 use crate::analysis::monitor::{ChannelMonitor, MonitorEvent};
 use crate::twin::{Nuisance, SimulatedFault, Simulator};
@@ -152,7 +155,10 @@ pub fn stream_run(bench: &Bench, plan: &FalseAlarmPlan, run: &HealthyRun) -> Run
     let settings = bench.monitor_settings(machine, run.case.rpm);
     let mut watch = MonitorWatch::new(&settings);
     let mut see = |event: MonitorEvent| watch.see(event);
-    let mut monitor = ChannelMonitor::new(settings, freqs, None);
+    let mut monitor = witnessed_monitor(
+        ChannelMonitor::new(settings, freqs, None),
+        bench.witness_for(machine),
+    );
     let mut simulator = Simulator::new(signal.params);
     let mut block = vec![0f32; BLOCK];
     let mut counts = Vec::with_capacity(BLOCK);

@@ -14,6 +14,8 @@
 //! - [`run`]: one case through both paths.
 //! - [`summary`]: Pd tables, false-alarm rates, confusion matrices, CSV.
 //! - [`figure`]: Pd vs SNR per fault type.
+//! - [`agreement`]: the learned model's agreement decided at every point of a parameter grid
+//!   on the same records, to calibrate it.
 //! - [`false_alarms`]: hours of healthy signal through the monitor path, its flag rises per
 //!   hour of operation (`bearingd evaluate --false-alarm-hours H`).
 //! - [`recordings`]: real recordings of a manifest through `analyze` and through the daemon
@@ -23,6 +25,7 @@
 //! Deterministic: a case's result depends only on the sweep seed and the case, never on the
 //! thread that ran it or the order; results are kept in case order.
 
+pub mod agreement;
 pub mod false_alarms;
 pub mod figure;
 pub mod recordings;

@@ -6,17 +6,21 @@
 //!   the settings the daemon derives from the embedded default config), fed the whole record
 //!   as the sensor's integer counts in blocks with their sample positions, in sample time.
 
+use super::agreement::grid_verdicts;
 use super::sweep::{Case, Machine, NoiseLevel, Sweep, DEFAULT_SEVERITY};
+use crate::analysis::agreement::{Witness, WitnessOpinion};
 use crate::analysis::diagnosis::DecisionRule;
 use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisSettings, Diagnosis, Verdict};
 use crate::config::{Config, SensorConfig, SimConfig, Speed, Transport};
+use crate::learned::ModelError;
 use crate::messages::FaultKind;
 use crate::messages::FlagLevel;
-use crate::pipeline::monitor_settings;
+use crate::pipeline::{load_learned, monitor_settings};
 use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
 use serde::Serialize;
+use std::sync::Arc;
 
 /// What one path concluded about one record.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -93,6 +97,12 @@ pub struct RecordOutcome {
     pub candidates: Vec<FaultKind>,
     /// Fault scores in outer, inner, ball, cage order.
     pub scores: [f64; 4],
+    /// The learned model's opinion, when the bench has a model that knows the bearing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub learned: Option<WitnessOpinion>,
+    /// With a model: the verdict at each point of [`super::agreement::grid`].
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub agreement_grid: Vec<Predicted>,
 }
 
 /// The monitor path's outcome.
@@ -168,16 +178,29 @@ impl CaseResult {
     }
 }
 
-/// What every case of a sweep shares: the daemon's settings.
+/// What every case of a sweep shares: the daemon's settings, and the learned model its
+/// verdicts hear (`twin.learned_model`, with `analysis.agreement_*`).
 pub struct Bench {
     pub config: Config,
+    pub witness: Option<Arc<dyn Witness>>,
 }
 
 impl Bench {
     /// The embedded default config: the analysis and flag settings a new user's daemon runs.
     pub fn embedded() -> Result<Self, String> {
         let config = Config::default_embedded().map_err(|e| e.to_string())?;
-        Ok(Bench { config })
+        Bench::new(config).map_err(|e| e.to_string())
+    }
+
+    /// A bench with `config`'s settings and its learned model, loaded once.
+    pub fn new(config: Config) -> Result<Self, ModelError> {
+        let witness = load_learned(&config.twin)?.map(|m| m as Arc<dyn Witness>);
+        Ok(Bench { config, witness })
+    }
+
+    /// The witness, if it knows `machine`'s bearing (the model is trained for one geometry).
+    pub fn witness_for(&self, machine: &Machine) -> Option<&Arc<dyn Witness>> {
+        self.witness.as_ref().filter(|w| w.knows(&machine.bearing))
     }
 
     pub fn analysis(&self) -> &AnalysisSettings {
@@ -312,16 +335,32 @@ pub fn run_case(
     let signal = Simulator::record(params, sweep.monitor_s);
 
     let record_len = ((sweep.record_s * fs).round() as usize).min(signal.len());
+    let witness = bench.witness_for(machine);
     let record = analyzer
         .analyze(&signal[..record_len], fs, &freqs, bench.analysis())
-        .map(|analysis| record_outcome(&analysis.diagnosis, &analysis))
+        .map(|mut analysis| {
+            let Some(witness) = witness else {
+                return record_outcome(&analysis.diagnosis, &analysis);
+            };
+            let opinion = witness
+                .witness(&signal[..record_len], fs, freqs.shaft)
+                .ok()
+                .flatten();
+            let grid = grid_verdicts(&analysis, bench.analysis(), opinion);
+            analysis.hear_witness(opinion, bench.analysis());
+            RecordOutcome {
+                learned: opinion,
+                agreement_grid: grid,
+                ..record_outcome(&analysis.diagnosis, &analysis)
+            }
+        })
         .map_err(|e| e.to_string());
 
     let settings = bench.monitor_settings(machine, case.rpm);
     let scale = bench.scale_g_per_count();
     let mut counts = Vec::new();
     to_counts(&signal, scale, &mut counts);
-    let monitor = run_monitor(settings, freqs, &counts, scale);
+    let monitor = run_monitor(settings, freqs, &counts, scale, witness);
 
     CaseResult {
         case: case.clone(),
@@ -329,6 +368,17 @@ pub fn run_case(
         snr_db,
         record,
         monitor,
+    }
+}
+
+/// `monitor`, hearing `witness` if there is one.
+pub fn witnessed_monitor(
+    monitor: ChannelMonitor,
+    witness: Option<&Arc<dyn Witness>>,
+) -> ChannelMonitor {
+    match witness {
+        Some(witness) => monitor.with_witness(Arc::clone(witness)),
+        None => monitor,
     }
 }
 
@@ -355,6 +405,8 @@ pub fn record_outcome(
         reason: diagnosis.reason.clone(),
         candidates: diagnosis.candidates.clone(),
         scores: FaultKind::ALL.map(|kind| analysis.score(kind)),
+        learned: None,
+        agreement_grid: Vec::new(),
     }
 }
 
@@ -530,10 +582,11 @@ fn run_monitor(
     freqs: crate::bearing::FaultFrequencies,
     counts: &[i16],
     scale: f64,
+    witness: Option<&Arc<dyn Witness>>,
 ) -> MonitorOutcome {
     let mut watch = MonitorWatch::new(&settings);
     let mut see = |event: MonitorEvent| watch.see(event);
-    let mut monitor = ChannelMonitor::new(settings, freqs, None);
+    let mut monitor = witnessed_monitor(ChannelMonitor::new(settings, freqs, None), witness);
     for (i, block) in counts.chunks(BLOCK).enumerate() {
         monitor.push_counts((i * BLOCK) as u64, block, scale, &mut see);
     }

@@ -1,15 +1,15 @@
 //! Learned diagnosis trained only on synthetic data (seed 001, issue 14 item 4): a denoising
 //! autoencoder + 1-D CNN that reads a record's envelope spectrum on the shaft-order axis and
 //! gives class probabilities, trained on `bearingd dataset` output by `bearingd train`, run on
-//! the CPU with candle. It is an extra opinion: [`combine`] joins it to the envelope diagnosis
-//! so that it can settle what the envelope leaves open but never overrule or replace it.
+//! the CPU with candle. It is an extra opinion: the second witness of
+//! [`crate::analysis::agreement::decide`], which may let the envelope name its first-ranked
+//! fault on less evidence but never overrules or replaces it.
 //!
 //! - [`features`]: the input (order spectrum of a segment), the same in training and use;
 //! - [`network`]: the autoencoder and the classifier;
 //! - [`model`]: a trained model file (weights + model card) and its opinion of a record;
 //! - [`train`]: training on a data set, seeded;
-//! - [`combine`]: the decision rule with the envelope diagnosis (`combine`, used today, and
-//!   `decide`, the rule with the learned model's agreement meant to replace it, not called yet).
+//! - [`combine`]: the model as that witness, and what the report says of the outcome.
 
 pub mod combine;
 pub mod features;
@@ -17,7 +17,7 @@ pub mod model;
 pub mod network;
 pub mod train;
 
-pub use combine::{clear_leader, combine, Basis, Combined, EnvelopeView};
+pub use combine::{combined, Basis, Combined};
 pub use features::FeatureSettings;
 pub use model::{LearnedModel, LearnedOpinion, ModelCard, ModelError};
 pub use train::{train, EpochReport, Trained, TrainingError, TrainingSet, TrainingSettings};

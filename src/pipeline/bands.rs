@@ -106,6 +106,7 @@ mod tests {
             max_shaft_hz: freqs.shaft,
             speed: SpeedMode::Fixed,
             analysis: AnalysisSettings::default(),
+            witness: None,
         });
         let worker = BandWorker::start(2).unwrap();
         let mut threaded = worker.selector();

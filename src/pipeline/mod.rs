@@ -19,10 +19,10 @@ pub mod refit;
 mod sink;
 pub mod twin_queue;
 
-pub use refit::TwinWorker;
+pub use refit::{load_learned, TwinWorker};
 pub use sink::{Sink, SinkError};
 
-use crate::analysis::diagnosis::Verdict;
+use crate::analysis::agreement::Witness;
 use crate::analysis::flags::FlagSettings;
 use crate::analysis::health::Baseline;
 use crate::analysis::monitor::{
@@ -32,7 +32,6 @@ use crate::analysis::speed::SpeedSearch;
 use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
 use crate::config::{Config, SensorConfig, Speed};
-use crate::learned::{clear_leader, EnvelopeView};
 use crate::messages::{
     ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage, HealthStage,
     IndicatorsMessage, IngestMessage, IsoZone, PipelineMessage, RawBlock, SpectrumMessage,
@@ -41,6 +40,7 @@ use crate::messages::{
 };
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// What the pipeline consumes.
 #[derive(Debug, Clone)]
@@ -87,23 +87,20 @@ pub struct TwinRequest {
     /// Bands of the outer-race, inner-race and ball hypotheses.
     pub bands: [Band; 3],
     pub samples: Vec<f32>,
-    /// What the envelope evidence says at the request (for the learned opinion's combination).
-    pub envelope: EnvelopeView,
+    /// The fault of the channel's highest raised flag (none when every flag is ok), and the
+    /// fault its latest verdict named by agreement with the learned model: what the learned
+    /// opinion logged with the fit is compared with.
+    pub flagged: Option<FaultKind>,
+    pub agreed: Option<FaultKind>,
 }
 
-/// The envelope evidence of a channel as the learned opinion's combination reads it: the fault
-/// of the highest raised flag (none when every flag is ok) and the latest window's clear leader.
-fn envelope_view(monitor: &ChannelMonitor) -> EnvelopeView {
+/// The fault of a channel's highest raised flag; `None` when every flag is ok.
+fn flagged_fault(monitor: &ChannelMonitor) -> Option<FaultKind> {
     let levels = monitor.flag_levels();
-    let flagged = (0..4)
+    (0..4)
         .filter(|&i| levels[i] != FlagLevel::Ok)
         .max_by_key(|&i| levels[i])
-        .map(|i| FaultKind::ALL[i]);
-    EnvelopeView {
-        verdict: flagged.map_or(Verdict::None, Verdict::from),
-        candidates: Vec::new(),
-        clear_leader: clear_leader(monitor.latest_scores(), &monitor.decision_rule()),
-    }
+        .map(|i| FaultKind::ALL[i])
 }
 
 /// What the pipeline produces.
@@ -301,8 +298,14 @@ impl Channel {
 }
 
 impl Pipeline {
-    /// One monitor per (sensor, axis); `baselines` resumes health stages kept across restarts.
-    pub fn new(config: &Config, baselines: &BTreeMap<ChannelId, Baseline>) -> Self {
+    /// One monitor per (sensor, axis); `baselines` resumes health stages kept across restarts;
+    /// `witness` (the learned model) is heard by every channel's verdicts when
+    /// `analysis.agreement_*` is set.
+    pub fn new(
+        config: &Config,
+        baselines: &BTreeMap<ChannelId, Baseline>,
+        witness: Option<Arc<dyn Witness>>,
+    ) -> Self {
         let mut channels = BTreeMap::new();
         let turns: usize = config.sensors.iter().map(|s| s.axes.len()).sum();
         let mut turn = 0;
@@ -325,6 +328,9 @@ impl Pipeline {
                     freqs,
                     baselines.get(&id).cloned(),
                 );
+                if let Some(witness) = &witness {
+                    monitor = monitor.with_witness(Arc::clone(witness));
+                }
                 if let Some(worker) = &worker {
                     // The channels' first selections (all due when their histories fill) take
                     // turns, FIRST_SELECTION_SPACING_S apart (within one band period), so that
@@ -453,7 +459,8 @@ impl Pipeline {
                             freqs: *c.monitor.frequencies(),
                             bands: [bands[0], bands[1], bands[2]],
                             samples: c.monitor.recent_samples((twin_window_s * fs) as usize),
-                            envelope: envelope_view(&c.monitor),
+                            flagged: flagged_fault(&c.monitor),
+                            agreed: c.monitor.agreed_fault(),
                         }));
                     }
                 }

@@ -8,7 +8,7 @@
 use super::TwinRequest;
 use crate::analysis::envelope::{window_samples, FftPlans};
 use crate::config::TwinConfig;
-use crate::learned::{combine, Basis, LearnedModel, ModelError};
+use crate::learned::{LearnedModel, ModelError};
 use crate::messages::{
     ChannelId, ClassProbability, HwMessage, LearnedOpinionMessage, PipelineMessage, TwinMessage,
 };
@@ -16,6 +16,18 @@ use crate::twin::diagnose::fit_record;
 use crate::twin::hw::{HwConfig, HwError, HwTracker, HwUpdate};
 use crate::twin::{TwinFitter, TwinParams};
 use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// `twin.learned_model`, loaded once per process: the twin's re-fits log its opinion, and the
+/// band jobs' verdicts hear it as their second witness (`analysis.agreement_*`).
+pub fn load_learned(config: &TwinConfig) -> Result<Option<Arc<LearnedModel>>, ModelError> {
+    Ok(config
+        .learned_model
+        .as_deref()
+        .map(LearnedModel::load)
+        .transpose()?
+        .map(Arc::new))
+}
 
 /// Re-fits the twins of every channel, keeping each channel's last parameters.
 pub struct TwinWorker {
@@ -26,7 +38,7 @@ pub struct TwinWorker {
     hw: Option<HwSettings>,
     hw_trackers: BTreeMap<ChannelId, HwTracker>,
     /// `twin.learned_model`, loaded.
-    learned: Option<LearnedModel>,
+    learned: Option<Arc<LearnedModel>>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -40,15 +52,11 @@ struct HwSettings {
 const WINDOW_FRACTION: f64 = 0.25;
 
 impl TwinWorker {
-    /// Loads the learned model if one is configured (its bearing was checked against the
-    /// sensors' when the config was validated).
-    pub fn new(config: &TwinConfig) -> Result<Self, ModelError> {
-        let learned = config
-            .learned_model
-            .as_deref()
-            .map(LearnedModel::load)
-            .transpose()?;
-        Ok(TwinWorker {
+    /// The worker, with the learned model (`twin.learned_model`, loaded once by the caller with
+    /// [`load_learned`]; its bearing was checked against the sensors' when the config was
+    /// validated).
+    pub fn new(config: &TwinConfig, learned: Option<Arc<LearnedModel>>) -> Self {
+        TwinWorker {
             plans: FftPlans::default(),
             fitter: TwinFitter::default(),
             previous: BTreeMap::new(),
@@ -59,7 +67,7 @@ impl TwinWorker {
             }),
             hw_trackers: BTreeMap::new(),
             learned,
-        })
+        }
     }
 
     /// Both models on one request, each handed to `out` as soon as it is made: the twin's fit
@@ -162,7 +170,7 @@ impl TwinWorker {
                     })
                 }
             };
-        let combined = combine(&request.envelope, &opinion);
+        let top = opinion.top().0.kind();
         Some(LearnedOpinionMessage {
             segments: opinion.segments,
             probabilities: opinion
@@ -173,10 +181,8 @@ impl TwinWorker {
                     probability,
                 })
                 .collect(),
-            confirms: (combined.basis == Basis::EnvelopeConfirmedByLearned)
-                .then(|| combined.verdict.fault())
-                .flatten(),
-            agrees: combined.learned_agrees,
+            confirms: request.agreed,
+            agrees: top == request.flagged,
             problem: None,
         })
     }

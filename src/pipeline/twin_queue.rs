@@ -134,11 +134,8 @@ mod tests {
             freqs: f,
             bands: [Band::new(100.0, 200.0); 3],
             samples: Vec::new(),
-            envelope: crate::learned::EnvelopeView {
-                verdict: crate::analysis::diagnosis::Verdict::None,
-                candidates: Vec::new(),
-                clear_leader: None,
-            },
+            flagged: None,
+            agreed: None,
         }
     }
 

@@ -298,19 +298,15 @@ impl AnalyzeReport {
     }
 
     /// Adds the learned opinion; the diagnosis becomes the combined one.
-    pub fn set_learned(&mut self, opinion: LearnedOpinion, combined: Combined) {
-        let envelope_diagnosis = self.diagnosis;
-        self.diagnosis = combined.verdict.name();
-        self.verdict = combined.verdict;
-        if combined.basis == Basis::EnvelopeConfirmedByLearned {
-            self.reason = combined.reason;
-            self.candidates.clear();
-        } else {
+    /// The learned model's part, once the verdict (this report's) has heard it as a witness;
+    /// `envelope` is what the envelope alone said.
+    pub fn set_learned(&mut self, opinion: LearnedOpinion, combined: Combined, envelope: Verdict) {
+        if combined.basis == Basis::Envelope {
             self.reason = format!("{}; {}", self.reason, combined.reason);
         }
         self.learned = Some(LearnedReport {
             opinion,
-            envelope_diagnosis,
+            envelope_diagnosis: envelope.name(),
             basis: combined.basis,
             learned_agrees: combined.learned_agrees,
         });

@@ -169,7 +169,7 @@ fn fault_line(f: &Facts, named: &Named) -> String {
     let mut sure = Sureness::of(f.confidence);
     match f.learned {
         Some(LearnedFacts {
-            basis: Basis::EnvelopeConfirmedByLearned,
+            basis: Basis::Agreement,
             ..
         }) => {
             // The spectrum alone did not name it, and the confidence is that of its `none`:
@@ -307,7 +307,7 @@ pub fn why_not(f: &Facts, h: &HypothesisReport) -> Option<String> {
     if let (
         Some(n),
         Some(LearnedFacts {
-            basis: Basis::EnvelopeConfirmedByLearned,
+            basis: Basis::Agreement,
             ..
         }),
     ) = (&named, f.learned)
@@ -618,7 +618,7 @@ mod tests {
         // The confidence is that of the spectrum's own `none`, whatever it is.
         let mut f = facts(Verdict::OuterRace, 0.55, &[], &h);
         f.learned = Some(LearnedFacts {
-            basis: Basis::EnvelopeConfirmedByLearned,
+            basis: Basis::Agreement,
             agrees: true,
         });
         let line = summary(&f);

@@ -6,19 +6,34 @@
 //! themselves (confident-wrong, disagreements) are printed, not asserted: the decision is
 //! still being changed (docs/DIAGNOSIS.md "Recordings").
 
+use bearingd::analysis::agreement::Agreement;
 use bearingd::evaluate::recordings::{
     evaluate_recordings, plan, render_recordings, tally, DaemonOutcome, Entry, Manifest,
-    RecordingsOptions, RecordingsReport, Truth,
+    RecordingsAgreement, RecordingsOptions, RecordingsReport, Truth,
 };
+use bearingd::evaluate::run::{CaseSignal, Predicted};
+use bearingd::evaluate::{NoiseLevel, Sweep};
+use bearingd::learned::LearnedModel;
+use bearingd::messages::FaultKind;
+use bearingd::twin::{SimulatedFault, Simulator};
 use bearingd_testdata::{mcap_files, scratch_dir, shared_data_dir};
 use std::collections::BTreeMap;
 use std::process::Command;
 
 fn run(manifests: &[Manifest], out: &std::path::Path) -> Vec<Entry> {
+    run_agreeing(manifests, out, None)
+}
+
+fn run_agreeing(
+    manifests: &[Manifest],
+    out: &std::path::Path,
+    agreement: Option<RecordingsAgreement>,
+) -> Vec<Entry> {
     let options = RecordingsOptions {
         all_channels: false,
         jobs: 2,
         scratch: out.to_path_buf(),
+        agreement,
     };
     evaluate_recordings(&plan(manifests, false), &options, &|_, _, _| {})
 }
@@ -308,4 +323,74 @@ fn missing_manifests_and_files_are_said_and_fail_under_strict() {
     let stderr = String::from_utf8_lossy(&strict.stderr);
     assert_eq!(strict.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("1 failed record(s)"), "{stderr}");
+}
+
+/// With the learned model's agreement (issue 30 item 3) `analyze` and the daemon decide with
+/// one rule: a weak outer-race record that the envelope alone leaves open (the seed-1 sweep's
+/// outer race on the 6205 at 0.6× speed, 1 g, 0 dB SNR; its first 10 s, as a CSV in g) is
+/// named by agreement in `analyze` and flagged the same by the daemon's replay of its import.
+#[test]
+fn with_the_learned_agreement_the_daemon_flags_what_analyze_names() {
+    let out = scratch_dir("evaluate-recordings-agreement");
+    let sweep = Sweep::full(1);
+    let machine = &sweep.machines[0];
+    let case = sweep
+        .cases()
+        .into_iter()
+        .find(|c| {
+            c.fault == SimulatedFault::OuterRace
+                && c.machine == 0
+                && (c.rpm - 0.6 * machine.nominal_rpm).abs() < 1e-6
+                && c.severity == 1.0
+                && c.noise == NoiseLevel::Snr(0.0)
+        })
+        .expect("the full sweep has the case");
+    let signal = CaseSignal::of(&case, machine, &sweep.nuisance);
+    let samples = Simulator::record(signal.params.clone(), 10.0);
+    let csv: String = samples.iter().map(|x| format!("{x}\n")).collect();
+    std::fs::write(out.join("weak_outer.csv"), csv).unwrap();
+    let path = out.join("manifest.csv");
+    std::fs::write(
+        &path,
+        format!(
+            "file,fault,rpm,fs_hz,bearing_geometry\nweak_outer.csv,outer,{},{},skf-6205-2rs\n",
+            case.rpm, machine.fs_hz
+        ),
+    )
+    .unwrap();
+    let manifest = [Manifest::read(&path).unwrap()];
+    let alone = run(&manifest, &out);
+    let Ok(envelope) = &alone[0].record else {
+        panic!("analyze failed: {:?}", alone[0].record)
+    };
+    assert_eq!(envelope.predicted, Predicted::None, "{}", envelope.reason);
+
+    let model_path = bearingd_testdata::repo_root().join("models/skf-6205-2rs.safetensors");
+    let agreement = RecordingsAgreement {
+        agreement: Agreement {
+            min_probability: 0.9,
+            min_score: 2.5,
+            min_lead: 1.5,
+            significance_relief_decades: 0.0,
+        },
+        model: std::sync::Arc::new(LearnedModel::load(&model_path).unwrap()),
+        model_path,
+    };
+    let entries = run_agreeing(&manifest, &out, Some(agreement));
+    let e = &entries[0];
+    let Ok(record) = &e.record else {
+        panic!("analyze failed: {:?}", e.record)
+    };
+    assert_eq!(
+        record.predicted,
+        Predicted::Fault(FaultKind::OuterRace),
+        "{}",
+        record.reason
+    );
+    assert!(record.reason.contains("learned model"), "{}", record.reason);
+    let DaemonOutcome::Judged { monitor, flags, .. } = &e.daemon else {
+        panic!("the daemon judged nothing: {:?}", e.daemon)
+    };
+    assert_eq!(monitor.predicted, record.predicted, "flags {flags:?}");
+    assert_eq!(e.agree, Some(true));
 }

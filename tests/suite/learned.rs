@@ -115,7 +115,7 @@ fn on_cwru_the_combination_keeps_every_right_envelope_answer_and_adds_no_wrong_o
         if report.diagnosis != "none" && report.diagnosis != expected {
             problems.push(format!("{line} — a wrong class"));
         }
-        if learned.basis == Basis::EnvelopeConfirmedByLearned && report.diagnosis != expected {
+        if learned.basis == Basis::Agreement && report.diagnosis != expected {
             problems.push(format!("{line} — the network settled it wrongly"));
         }
         assert!(learned.opinion.segments >= 10, "{line}");

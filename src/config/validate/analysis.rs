@@ -1,7 +1,7 @@
 //! `[analysis]`: window, hop, band selection and fixed bands, checked against the sensors' rates.
 
 use super::*;
-use crate::analysis::diagnosis::Agreement;
+use crate::analysis::agreement::Agreement;
 
 /// (choice) The longest evidence horizon: a channel keeps its horizon as 16-bit counts, 2 bytes
 /// per sample (10 minutes at 25.6 kHz: 31 MB per channel).

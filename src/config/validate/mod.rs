@@ -54,6 +54,16 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
     let outputs = check.outputs(&raw.outputs, &sensors);
     let fleet = check.fleet(&raw.fleet, outputs.as_ref().map(|o| o.state_dir.as_path()));
     let severity = check.severity(&raw.severity);
+    if let (Some((analysis, ..)), Some(twin)) = (&analysis, &twin) {
+        if analysis.agreement.is_some() && twin.learned_model.is_none() {
+            check.problem(
+                "analysis.agreement_probability",
+                "the learned model's agreement has no model to agree with; set \
+                 twin.learned_model, e.g. learned_model = \
+                 \"/usr/share/bearingd/skf-6205-2rs.safetensors\", or remove the agreement_* keys",
+            );
+        }
+    }
 
     let sensors: Option<Vec<SensorConfig>> = sensors.into_iter().map(|s| s.config).collect();
     match (

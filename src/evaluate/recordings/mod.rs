@@ -36,10 +36,13 @@ pub use manifest::{Manifest, ManifestError, ManifestRecord, Truth};
 pub use tally::{render_recordings, tally, Said, Tally};
 
 use super::run::{record_outcome, MonitorOutcome, Predicted, RecordOutcome};
+use crate::analysis::agreement::{Agreement, Witness};
 use crate::analysis::record::RecordAnalyzer;
+use crate::analysis::AnalysisSettings;
 use crate::config::Config;
 use crate::daemon::events::{DaemonEvent, Events};
 use crate::daemon::{replay, ReplayOptions, RunStart};
+use crate::learned::{LearnedModel, ModelError};
 use crate::messages::{FaultKind, FlagLevel, HealthKind, PipelineMessage};
 use crate::offline::{analyze_recording, resolve_conditions, AnalyzeRequest};
 use crate::pipeline::{Sink, SinkError};
@@ -64,6 +67,37 @@ pub struct RecordingsOptions {
     /// Where the imported logs are written for their replay (a folder of this run's own is
     /// made inside, and removed at the end).
     pub scratch: PathBuf,
+    /// The learned model's agreement both paths decide with (`--config`'s `agreement_*` and
+    /// `twin.learned_model`), on the records of a bearing the model knows; `None`: the
+    /// envelope alone, as `analyze` and `import` default to.
+    pub agreement: Option<RecordingsAgreement>,
+}
+
+/// The agreement of [`RecordingsOptions::agreement`].
+#[derive(Debug, Clone)]
+pub struct RecordingsAgreement {
+    pub agreement: Agreement,
+    /// The model file, for the replay's config.
+    pub model_path: PathBuf,
+    pub model: Arc<LearnedModel>,
+}
+
+impl RecordingsAgreement {
+    /// The agreement of a config with both `agreement_*` and `twin.learned_model`; `None`
+    /// without either.
+    pub fn of(config: &Config) -> Result<Option<Self>, ModelError> {
+        let (Some(agreement), Some(model_path)) =
+            (config.analysis.agreement, config.twin.learned_model.clone())
+        else {
+            return Ok(None);
+        };
+        let model = Arc::new(LearnedModel::load(&model_path)?);
+        Ok(Some(RecordingsAgreement {
+            agreement,
+            model_path,
+            model,
+        }))
+    }
 }
 
 /// What `recordings.json` holds: the run, its summary, and every entry the summary counts.
@@ -290,15 +324,24 @@ pub fn evaluate_recordings(
         &numbered,
         options.jobs,
         RecordAnalyzer::default,
-        |analyzer, (index, task)| evaluate_task(task, &scratch.join(index.to_string()), analyzer),
+        |analyzer, (index, task)| {
+            let agreement = options.agreement.as_ref();
+            evaluate_task(task, &scratch.join(index.to_string()), agreement, analyzer)
+        },
         progress,
     );
     let _ = std::fs::remove_dir_all(&scratch);
     entries
 }
 
-/// One task through both paths; `scratch` is its own folder for the imported log (removed).
-pub fn evaluate_task(task: &Task, scratch: &Path, analyzer: &mut RecordAnalyzer) -> Entry {
+/// One task through both paths; `scratch` is its own folder for the imported log (removed);
+/// both decide with `agreement` when the model knows the record's bearing.
+pub fn evaluate_task(
+    task: &Task,
+    scratch: &Path,
+    witness: Option<&RecordingsAgreement>,
+    analyzer: &mut RecordAnalyzer,
+) -> Entry {
     if let Some(problem) = &task.problem {
         return Entry::failed(task, task.channel.clone(), problem);
     }
@@ -327,6 +370,18 @@ pub fn evaluate_task(task: &Task, scratch: &Path, analyzer: &mut RecordAnalyzer)
         Err(e) => return Entry::failed(task, channel, &e.to_string()),
     };
     let seconds = recording.samples.len() as f64 / conditions.fs_hz;
+    let witness = witness.filter(|a| a.model.knows(&conditions.bearing));
+    let request = match witness {
+        Some(a) => AnalyzeRequest {
+            settings: AnalysisSettings {
+                agreement: Some(a.agreement),
+                ..request.settings
+            },
+            learned: Some(Arc::clone(&a.model)),
+            ..request
+        },
+        None => request,
+    };
     let (record, warnings) = match analyze_recording(&recording, false, &request, analyzer) {
         Ok(outcome) => (
             Ok(record_outcome(
@@ -348,7 +403,7 @@ pub fn evaluate_task(task: &Task, scratch: &Path, analyzer: &mut RecordAnalyzer)
             bearing: &conditions.bearing,
         },
     }) {
-        Ok(_) => replay_imported(scratch, conditions.fs_hz, seconds),
+        Ok(_) => replay_imported(scratch, conditions.fs_hz, seconds, witness),
         Err(e) => DaemonOutcome::Failed {
             error: format!("import: {e}"),
         },
@@ -442,15 +497,21 @@ impl Sink for Watcher {
 }
 
 /// Replays the log `bearingd import` wrote into `dir`, as `bearingd replay DIR/*.mcap` does
-/// (the log's own settings), and says what the daemon concluded.
-fn replay_imported(dir: &Path, fs_hz: f64, seconds: f64) -> DaemonOutcome {
+/// (the log's own settings, with `agreement` and its model added when given), and says what
+/// the daemon concluded.
+fn replay_imported(
+    dir: &Path,
+    fs_hz: f64,
+    seconds: f64,
+    agreement: Option<&RecordingsAgreement>,
+) -> DaemonOutcome {
     let failed = |error: String| DaemonOutcome::Failed { error };
     let files = mcap_files(dir);
     let plan = match ReplayPlan::new(&files) {
         Ok(plan) => plan,
         Err(e) => return failed(format!("replay: {e}")),
     };
-    let config: Config = match plan.logged_settings() {
+    let mut config: Config = match plan.logged_settings() {
         LoggedSettings::Logged { config, .. } => *config,
         _ => {
             return failed(format!(
@@ -459,6 +520,10 @@ fn replay_imported(dir: &Path, fs_hz: f64, seconds: f64) -> DaemonOutcome {
             ))
         }
     };
+    if let Some(a) = agreement {
+        config.analysis.agreement = Some(a.agreement);
+        config.twin.learned_model = Some(a.model_path.clone());
+    }
     let watched = Arc::new(Mutex::new(Watched::default()));
     let unreadable = Arc::new(Mutex::new(Vec::new()));
     let mut open_sinks = |_: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {

@@ -355,6 +355,8 @@ mod tests {
             reason: String::new(),
             candidates: Vec::new(),
             scores: [0.0; 4],
+            learned: None,
+            agreement_grid: Vec::new(),
         })
     }
 
