@@ -49,6 +49,8 @@
 //! - [`random`]: seeded random numbers (ChaCha8), the same on every machine, for the simulator
 //!   and for tests at every level (from `bearing-signal`).
 //! - [`clock`]: the one reading of the system clock, for the daemon's edges (sources, sinks).
+//! - [`fsafe`]: safe file creation in the data directories: no link followed where bearingd
+//!   writes, modes 0750/0640 whatever the umask, data directories others can write refused.
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
 
@@ -59,6 +61,7 @@ pub mod clock;
 pub mod config;
 pub mod daemon;
 pub mod evaluate;
+pub mod fsafe;
 pub mod iox;
 pub mod learned;
 pub mod life;

@@ -522,12 +522,19 @@ fn replay_of_a_file_that_is_not_mcap_exits_2_naming_it() {
 struct Tmpfs(PathBuf);
 
 impl Tmpfs {
-    /// Mounts it; `None` (said) when mounting is not permitted here, a failure under CI=true
-    /// (CI runs as root on Debian 12, where it is).
+    /// Mounts it, mode 0750 (a tmpfs is 1777 by default, a log directory the daemon refuses);
+    /// `None` (said) when mounting is not permitted here, a failure under CI=true (CI runs as
+    /// root on Debian 12, where it is).
     fn mount(dir: &Path, size: &str) -> Option<Tmpfs> {
         std::fs::create_dir_all(dir).unwrap();
         let out = Command::new("mount")
-            .args(["-t", "tmpfs", "-o", &format!("size={size}"), "tmpfs"])
+            .args([
+                "-t",
+                "tmpfs",
+                "-o",
+                &format!("size={size},mode=0750"),
+                "tmpfs",
+            ])
             .arg(dir)
             .output();
         match out {

@@ -55,6 +55,8 @@ enum SettingsFrom {
 }
 
 pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
+    // What the replay creates is never more open than 0750/0640, whatever umask it inherits.
+    crate::fsafe::restrict_umask();
     if let Some(speed) = args.speed {
         if !(speed.is_finite() && speed > 0.0) {
             return Err(CliError::input(format!(
@@ -88,8 +90,8 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     config.outputs.mcap_dir = args.out.clone();
     // The output directory has one owner too: recovery at open would otherwise rewrite the
     // open file of a daemon (or another replay) writing there.
-    std::fs::create_dir_all(&args.out)
-        .map_err(|e| CliError::input(format!("{}: cannot create: {e}", args.out.display())))?;
+    // Created 0750, and refused if others can write in it (they could plant links there).
+    crate::fsafe::prepare_private_dir(&args.out).map_err(CliError::input)?;
     let _lock = DirLock::acquire(&args.out).map_err(CliError::input)?;
     let mut open_sinks =
         |run: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {

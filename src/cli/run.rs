@@ -9,7 +9,7 @@ use crate::mcap_log::files::utc_text;
 use crate::messages::{FlagMessage, HealthKind, PipelineMessage, SpeedSource};
 use crate::pipeline::{ChannelStatus, Sink, SinkError};
 use crate::report::plain::flag_words;
-use crate::sinks::mcap::{LogNotice, RecoveryAction, RecoveryReport};
+use crate::sinks::mcap::{LogNotice, RecoveryAction, RecoveryReport, RetentionReport};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -84,6 +84,8 @@ impl Sink for FlagPrinter {
 }
 
 pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
+    // What the daemon creates is never more open than 0750/0640, whatever umask it inherits.
+    crate::fsafe::restrict_umask();
     let mut config = match &args.config {
         Some(path) => {
             let mut config = config::load(path).map_err(CliError::input)?;
@@ -234,17 +236,7 @@ pub(super) fn print_events() -> Events {
 /// How a notice of the MCAP log reads on stderr.
 fn log_notice_line(notice: &LogNotice) -> String {
     match notice {
-        LogNotice::Retention(report) => format!(
-            "bearingd: retention: deleted {} ({} bytes) to keep the logs within outputs.mcap_disk_budget_mb; {} bytes of logs left",
-            report
-                .deleted
-                .iter()
-                .map(|p| p.display().to_string())
-                .collect::<Vec<_>>()
-                .join(", "),
-            report.bytes_deleted,
-            report.total_bytes_after
-        ),
+        LogNotice::Retention(report) => retention_line(report),
         LogNotice::Paused {
             path,
             error,
@@ -363,6 +355,28 @@ pub(super) fn event_line(event: &DaemonEvent) -> String {
     }
 }
 
+/// What a retention pass deleted, and what it left alone (names that are not its files).
+fn retention_line(report: &RetentionReport) -> String {
+    let mut lines = Vec::new();
+    if !report.deleted.is_empty() {
+        lines.push(format!(
+            "bearingd: retention: deleted {} ({} bytes) to keep the logs within outputs.mcap_disk_budget_mb; {} bytes of logs left",
+            report
+                .deleted
+                .iter()
+                .map(|p| p.display().to_string())
+                .collect::<Vec<_>>()
+                .join(", "),
+            report.bytes_deleted,
+            report.total_bytes_after
+        ));
+    }
+    for skipped in &report.skipped {
+        lines.push(format!("bearingd: warning: retention left alone {skipped}"));
+    }
+    lines.join("\n")
+}
+
 /// What recovery did with one unfinished file, in one line.
 fn recovery_line(report: &RecoveryReport) -> String {
     let problem = report
@@ -385,6 +399,9 @@ fn recovery_line(report: &RecoveryReport) -> String {
             "bearingd: warning: {path} could not be recovered ({reason}); moved, untouched, to {}",
             to.display()
         ),
+        RecoveryAction::Skipped(why) => {
+            format!("bearingd: warning: recovery left alone {why}")
+        }
         RecoveryAction::RemovedEmpty => {
             format!("bearingd: removed {path}: an empty file (0 bytes) left by an earlier start")
         }

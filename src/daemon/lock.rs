@@ -10,8 +10,14 @@
 //! its holder dies, so a lock file whose text is left but whose lock is free belongs to a
 //! process that did not stop cleanly (a `kill -9`, a power cut): it is taken over, and the
 //! caller is told whose it was. A clean stop empties the file, so the next start says nothing.
+//!
+//! The lock file is opened without following a link (`O_NOFOLLOW`) and must be this user's
+//! regular file: a link named `bearingd.lock` planted to another file is refused, never
+//! truncated, and nothing of another file is read into a message (issue 32). Only the first
+//! line, at most [`MAX_HOLDER_BYTES`], of our own lock file is ever read.
 
 use crate::clock::wall_clock_now_ns;
+use crate::fsafe::{check_own_regular, no_follow, NotOwnFile};
 use crate::mcap_log::files::utc_text;
 use crate::sinks::mcap::metadata::host_name;
 use std::fs::{File, OpenOptions, TryLockError};
@@ -20,6 +26,8 @@ use std::path::{Path, PathBuf};
 
 /// The lock file's name inside each locked directory.
 pub const LOCK_FILE: &str = "bearingd.lock";
+/// What is read of a lock file to name its holder, at most.
+pub const MAX_HOLDER_BYTES: u64 = 256;
 
 /// Why a directory could not be locked.
 #[derive(Debug, thiserror::Error)]
@@ -35,6 +43,8 @@ pub enum LockError {
         op: &'static str,
         source: std::io::Error,
     },
+    #[error("lock file: {0}")]
+    NotOwnFile(#[from] NotOwnFile),
 }
 
 /// A held lock on a directory; released (and the file emptied) when dropped.
@@ -54,27 +64,36 @@ impl DirLock {
             let path = path.clone();
             move |source| LockError::Io { path, op, source }
         };
-        let mut file = OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .map_err(io("open"))?;
-        let mut previous = String::new();
+        let opened = no_follow(
+            OpenOptions::new()
+                .read(true)
+                .write(true)
+                .create(true)
+                .truncate(false),
+        )
+        .open(&path);
+        let mut file = match opened {
+            Err(e) if e.raw_os_error() == Some(libc::ELOOP) => {
+                return Err(LockError::NotOwnFile(NotOwnFile::NotRegular {
+                    path,
+                    kind: "a symbolic link",
+                }))
+            }
+            other => other.map_err(io("open"))?,
+        };
+        check_own_regular(&path, file.metadata().map_err(io("stat"))?)?;
         match file.try_lock() {
             Ok(()) => {}
             Err(TryLockError::WouldBlock) => {
                 // The holder may be writing its line right now; what is there names it.
-                let _ = file.read_to_string(&mut previous);
                 return Err(LockError::Held {
                     dir: dir.to_path_buf(),
-                    holder: holder_text(&previous),
+                    holder: holder_text(&first_line(&mut file).unwrap_or_default()),
                 });
             }
             Err(TryLockError::Error(e)) => return Err(io("lock")(e)),
         }
-        file.read_to_string(&mut previous).map_err(io("read"))?;
+        let previous = first_line(&mut file).map_err(io("read"))?;
         let line = format!(
             "pid={} host={} started={}\n",
             std::process::id(),
@@ -105,6 +124,16 @@ impl Drop for DirLock {
         let _ = self.file.set_len(0);
         let _ = self.file.sync_all();
     }
+}
+
+/// The first line of the lock file, read from its start, at most [`MAX_HOLDER_BYTES`].
+fn first_line(file: &mut File) -> std::io::Result<String> {
+    let mut bytes = Vec::new();
+    (&mut *file)
+        .take(MAX_HOLDER_BYTES)
+        .read_to_end(&mut bytes)?;
+    let text = String::from_utf8_lossy(&bytes);
+    Ok(text.lines().next().unwrap_or_default().to_string())
 }
 
 fn holder_text(text: &str) -> String {
@@ -152,6 +181,20 @@ mod tests {
             lock.taken_over_from.as_deref(),
             Some("pid=999999 host=old started=x")
         );
+        drop(lock);
+        // A link in its place is refused: its target neither truncated nor read.
+        let victim = dir.join("victim");
+        std::fs::write(&victim, "secret\n").unwrap();
+        std::fs::remove_file(dir.join(LOCK_FILE)).unwrap();
+        std::os::unix::fs::symlink(&victim, dir.join(LOCK_FILE)).unwrap();
+        let err = DirLock::acquire(&dir).unwrap_err().to_string();
+        assert!(
+            err.contains("symbolic link") && !err.contains("secret"),
+            "{err}"
+        );
+        assert_eq!(std::fs::read_to_string(&victim).unwrap(), "secret\n");
+        std::fs::remove_file(dir.join(LOCK_FILE)).unwrap();
+        let lock = DirLock::acquire(&dir).unwrap();
         let text = std::fs::read_to_string(lock.path()).unwrap();
         assert!(
             text.starts_with(&format!("pid={} ", std::process::id())),

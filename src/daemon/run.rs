@@ -92,6 +92,8 @@ pub enum RunError {
     },
     #[error(transparent)]
     Locked(#[from] LockError),
+    #[error("data directory refused: {0}")]
+    UnsafeDir(#[from] crate::fsafe::UnsafeDir),
     #[error("MCAP log: {0}")]
     Log(#[from] McapLogError),
     #[cfg(feature = "shm")]
@@ -263,14 +265,22 @@ fn cap_cpu_latency(config: &Config, events: &Events) -> Option<CpuLatencyCap> {
     }
 }
 
-/// Creates `outputs.state_dir` if it is missing.
+/// Creates `outputs.state_dir` if it is missing (0750); refuses it if others can write in it.
 fn prepare_state_dir(config: &Config) -> Result<PathBuf, RunError> {
     let state_dir = config.outputs.state_dir.clone();
-    std::fs::create_dir_all(&state_dir).map_err(|source| RunError::Directory {
-        path: state_dir.clone(),
+    prepare_data_dir(&state_dir)?;
+    Ok(state_dir)
+}
+
+/// Creates `dir` if it is missing (0750) and refuses it if other users could plant files in
+/// it ([`crate::fsafe::check_private_dir`]).
+fn prepare_data_dir(dir: &Path) -> Result<(), RunError> {
+    crate::fsafe::create_dir_all(dir).map_err(|source| RunError::Directory {
+        path: dir.to_path_buf(),
         source,
     })?;
-    Ok(state_dir)
+    crate::fsafe::check_private_dir(dir)?;
+    Ok(())
 }
 
 /// Locks the log and state directories (one owner each) before anything in them is opened;
@@ -280,10 +290,7 @@ fn lock_data_dirs(config: &Config, events: &Events) -> Result<Vec<DirLock>, RunE
     let mut locks: Vec<DirLock> = Vec::new();
     let mut locked: Vec<PathBuf> = Vec::new();
     for dir in dirs {
-        std::fs::create_dir_all(dir).map_err(|source| RunError::Directory {
-            path: dir.clone(),
-            source,
-        })?;
+        prepare_data_dir(dir)?;
         let same = std::fs::canonicalize(dir).unwrap_or_else(|_| dir.clone());
         if locked.contains(&same) {
             continue;

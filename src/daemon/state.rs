@@ -4,12 +4,14 @@
 //! Saved every `outputs.state_save_interval_s` while running and at every stop, each time
 //! atomically (write a temporary file, fsync it, rename it over the old one, fsync the
 //! directory): a `kill -9` or a power cut finds either the previous save or the new one, never
-//! half a file, and loses at most one period of learning.
+//! half a file, and loses at most one period of learning. The save never writes through a
+//! link planted in the directory ([`crate::fsafe::replace`]), and a `baselines.json` that is
+//! not this user's regular file is not read.
 
 use crate::analysis::health::{baselines_from_json, baselines_to_json, Baseline};
 use crate::messages::ChannelId;
 use std::collections::BTreeMap;
-use std::io::Write;
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 const BASELINES_FILE: &str = "baselines.json";
@@ -44,9 +46,19 @@ pub fn load_baselines(
     Result<Option<StateLoaded>, StateError>,
 ) {
     let path = state_dir.join(BASELINES_FILE);
-    let Ok(text) = std::fs::read_to_string(&path) else {
+    if std::fs::symlink_metadata(&path).is_err() {
         return (BTreeMap::new(), Ok(None));
-    };
+    }
+    let mut text = String::new();
+    let read = crate::fsafe::open_own_file(&path)
+        .map_err(|e| e.to_string())
+        .and_then(|mut file| file.read_to_string(&mut text).map_err(|e| e.to_string()));
+    if let Err(detail) = read {
+        return (
+            BTreeMap::new(),
+            Err(StateError::Unreadable { path, detail }),
+        );
+    }
     let saved_at_ns = std::fs::metadata(&path)
         .and_then(|m| m.modified())
         .ok()
@@ -77,15 +89,9 @@ pub fn save_baselines(
     baselines: &BTreeMap<ChannelId, Baseline>,
 ) -> Result<(), StateError> {
     let path = state_dir.join(BASELINES_FILE);
-    let temporary = state_dir.join(format!("{BASELINES_FILE}.new"));
     let write = || -> std::io::Result<()> {
         let text = baselines_to_json(baselines).map_err(std::io::Error::other)?;
-        let mut file = std::fs::File::create(&temporary)?;
-        file.write_all(text.as_bytes())?;
-        file.sync_all()?;
-        drop(file);
-        std::fs::rename(&temporary, &path)?;
-        std::fs::File::open(state_dir)?.sync_all()
+        crate::fsafe::replace(&path, text.as_bytes())
     };
     write().map_err(|source| StateError::NotSaved { path, source })
 }

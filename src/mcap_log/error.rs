@@ -36,6 +36,10 @@ pub enum McapLogError {
         offset: u64,
         reason: String,
     },
+    /// A log-named entry is not this user's regular file (a link, a directory, another user's
+    /// file): it is not read, rewritten or deleted.
+    #[error(transparent)]
+    NotOwnFile(#[from] crate::fsafe::NotOwnFile),
     /// A logger setting is unusable.
     #[error("MCAP logger config: {0}")]
     Config(String),

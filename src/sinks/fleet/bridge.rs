@@ -285,10 +285,7 @@ fn read_bd_seq(dir: &Path) -> Option<u64> {
 
 /// Records the `bdSeq` of an accepted CONNECT, so that a restarted daemon uses the next one.
 fn write_bd_seq(dir: &Path, bd_seq: u64) -> std::io::Result<()> {
-    let temporary = dir.join(format!("{BD_SEQ_FILE}.new"));
-    std::fs::write(&temporary, format!("{bd_seq}\n"))?;
-    std::fs::File::open(&temporary)?.sync_data()?;
-    std::fs::rename(&temporary, dir.join(BD_SEQ_FILE))
+    crate::fsafe::replace(&dir.join(BD_SEQ_FILE), format!("{bd_seq}\n").as_bytes())
 }
 
 fn now_ms() -> u64 {

@@ -131,7 +131,7 @@ pub struct DiskQueue {
 impl DiskQueue {
     /// Opens (or creates) the queue in `dir`, bounded to `max_bytes` of segment files.
     pub fn open(dir: &Path, max_bytes: u64) -> Result<(DiskQueue, OpenReport)> {
-        std::fs::create_dir_all(dir).map_err(io(dir, "create the queue directory"))?;
+        crate::fsafe::create_dir_all(dir).map_err(io(dir, "create the queue directory"))?;
         let head_path = dir.join(HEAD_FILE);
         let head = match std::fs::read_to_string(&head_path) {
             Ok(text) => text.trim().parse::<u64>().unwrap_or(0),
@@ -186,8 +186,7 @@ impl DiskQueue {
         let segment_bytes = (max_bytes / 16).clamp(4096, 16 << 20);
         let tail = match segments.back() {
             Some(last) => Some(
-                OpenOptions::new()
-                    .append(true)
+                crate::fsafe::no_follow(OpenOptions::new().append(true))
                     .open(&last.path)
                     .map_err(io(&last.path, "open the newest segment"))?,
             ),
@@ -292,12 +291,10 @@ impl DiskQueue {
         // The previous tail is complete: make it durable before moving on.
         self.sync_tail()?;
         let path = self.dir.join(format!("{:020}.seg", self.next));
-        let file = OpenOptions::new()
-            .create(true)
-            .truncate(true)
-            .write(true)
-            .open(&path)
-            .map_err(io(&path, "create a queue segment"))?;
+        let file =
+            crate::fsafe::no_follow(OpenOptions::new().create(true).truncate(true).write(true))
+                .open(&path)
+                .map_err(io(&path, "create a queue segment"))?;
         self.tail = Some(file);
         self.segments.push_back(Segment {
             path,
@@ -418,12 +415,8 @@ impl DiskQueue {
 
     fn write_head(&mut self) -> Result<()> {
         let path = self.dir.join(HEAD_FILE);
-        let temporary = self.dir.join("head.new");
-        let mut file = File::create(&temporary).map_err(io(&temporary, "create"))?;
-        file.write_all(format!("{}\n", self.head).as_bytes())
-            .map_err(io(&temporary, "write"))?;
-        file.sync_data().map_err(io(&temporary, "fsync"))?;
-        std::fs::rename(&temporary, &path).map_err(io(&path, "replace"))?;
+        crate::fsafe::replace(&path, format!("{}\n", self.head).as_bytes())
+            .map_err(io(&path, "replace"))?;
         self.head_on_disk = self.head;
         self.dir_dirty = true;
         Ok(())
@@ -457,8 +450,7 @@ fn read_segment(path: &Path, first: u64) -> Result<(Segment, u64)> {
     }
     let cut = (bytes.len() - at) as u64;
     if cut > 0 {
-        let file = OpenOptions::new()
-            .write(true)
+        let file = crate::fsafe::no_follow(OpenOptions::new().write(true))
             .open(path)
             .map_err(io(path, "open a torn segment"))?;
         file.set_len(at as u64)

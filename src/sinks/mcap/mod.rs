@@ -144,7 +144,7 @@ impl McapSink {
         rates: HashMap<String, f64>,
         origin_ns: u64,
     ) -> Result<(Self, Vec<RecoveryReport>), McapLogError> {
-        std::fs::create_dir_all(&config.dir).map_err(|source| McapLogError::Io {
+        crate::fsafe::create_dir_all(&config.dir).map_err(|source| McapLogError::Io {
             path: config.dir.clone(),
             op: "create the log directory",
             source,
@@ -244,10 +244,10 @@ impl McapSink {
         }
     }
 
-    /// Says a retention pass that deleted files, in the journal (the notice) and as one `/log`
-    /// note per deleted file in the open file.
+    /// Says a retention pass that deleted files (or skipped names that are not its own files),
+    /// in the journal (the notice) and as one `/log` note per deleted file in the open file.
     fn retention_done(&mut self, report: RetentionReport, at_ns: u64) {
-        if report.deleted.is_empty() {
+        if report.deleted.is_empty() && report.skipped.is_empty() {
             return;
         }
         if let Some(logger) = self.logger.as_mut() {

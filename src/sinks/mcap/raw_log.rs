@@ -137,9 +137,12 @@ pub fn write_raw_log(log: &RawLog) -> Result<WrittenLog, RawLogError> {
     }
     let path = logger.current_path().map(|p| p.to_path_buf());
     logger.finish().map_err(RawLogError::Write)?;
-    std::fs::write(&config_path, config_text).map_err(|source| RawLogError::Io {
-        path: config_path.clone(),
-        source,
+    // Replaced, not written through: a link named replay.toml is not followed.
+    crate::fsafe::replace(&config_path, config_text.as_bytes()).map_err(|source| {
+        RawLogError::Io {
+            path: config_path.clone(),
+            source,
+        }
     })?;
     Ok(WrittenLog {
         path,

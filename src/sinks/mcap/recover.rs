@@ -20,18 +20,25 @@
 //!   A cut-off tail (the chunk being written at the kill) cannot be decoded by anyone and is
 //!   only counted.
 //!
+//! Only this user's regular files are read, rewritten, moved or deleted: a log-named link
+//! (to anything), directory, special file or another user's file is left alone and reported
+//! ([`RecoveryAction::Skipped`]); nothing is ever read through a link. The recovered copy is
+//! created beside the original (never through a link) with the original's mode, at most 0640.
+//!
 //! Quarantined files are never deleted by retention; the operator clears `quarantine/`.
 //! A leftover `*.recovering` from a crash during recovery is an incomplete copy (its original
 //! is still in place): it is deleted and the recovery redone.
 
 use std::collections::HashMap;
-use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions};
 
+use crate::fsafe::{
+    create_new_with_mode, open_own_file, own_regular_file, parent_dir, NotOwnFile, FILE_MODE,
+};
 use crate::mcap_log::error::{io_err, McapLogError, Result};
 use crate::mcap_log::files::is_log_file_name;
 use crate::mcap_log::scan::{ScanOutcome, ScannedRecord, Scanner};
@@ -64,6 +71,9 @@ pub enum RecoveryAction {
     Quarantined { to: PathBuf, reason: String },
     /// It was empty (0 bytes: nothing to keep) and was removed.
     RemovedEmpty,
+    /// It is not this user's regular file (a link, a directory, another user's file): left
+    /// alone, not read.
+    Skipped(NotOwnFile),
 }
 
 const TEMP_SUFFIX: &str = ".recovering";
@@ -74,33 +84,56 @@ pub const QUARANTINE_DIR: &str = "quarantine";
 /// module docs. Call it before opening a new logger in `dir`. Finished files are not touched.
 pub fn recover_directory(dir: &Path) -> Result<Vec<RecoveryReport>> {
     let mut names = Vec::new();
+    let mut reports = Vec::new();
     for entry in std::fs::read_dir(dir).map_err(io_err(dir, "list directory"))? {
         let entry = entry.map_err(io_err(dir, "list directory"))?;
         let name = entry.file_name().to_string_lossy().into_owned();
-        if name.ends_with(TEMP_SUFFIX) && is_log_file_name(name.trim_end_matches(TEMP_SUFFIX)) {
+        let leftover =
+            name.ends_with(TEMP_SUFFIX) && is_log_file_name(name.trim_end_matches(TEMP_SUFFIX));
+        if !leftover && !is_log_file_name(&name) {
+            continue;
+        }
+        if let Err(not_own) = own_regular_file(&entry.path()) {
+            reports.push(skipped(not_own));
+        } else if leftover {
             std::fs::remove_file(entry.path()).map_err(io_err(entry.path(), "delete"))?;
-        } else if is_log_file_name(&name) {
+        } else {
             names.push(name);
         }
     }
     names.sort();
-    let mut reports = Vec::new();
     for name in names {
         let path = dir.join(&name);
-        if !is_finished(&path)? {
-            reports.push(recover_file(&path)?);
+        match is_finished(&path) {
+            Ok(true) => {}
+            Ok(false) => reports.push(recover_file(&path)?),
+            Err(McapLogError::NotOwnFile(not_own)) => reports.push(skipped(not_own)),
+            Err(e) => return Err(e),
         }
     }
     Ok(reports)
 }
 
-/// Has `path` a footer and end magic at its end? (Reads only the last bytes.)
+/// The report of a name recovery leaves alone.
+fn skipped(not_own: NotOwnFile) -> RecoveryReport {
+    RecoveryReport {
+        path: not_own.path().to_path_buf(),
+        messages_recovered: 0,
+        unreadable_bytes: 0,
+        original_bytes: 0,
+        problem: None,
+        action: RecoveryAction::Skipped(not_own),
+    }
+}
+
+/// Has `path` a footer and end magic at its end? (Reads only the last bytes.) A name that is
+/// not this user's regular file is refused ([`McapLogError::NotOwnFile`]), not read.
 pub fn is_finished(path: &Path) -> Result<bool> {
     use std::io::{Read, Seek, SeekFrom};
     // Footer record: opcode, length (8), summary start (8), summary offset start (8), crc (4);
     // then the 8-byte magic.
     const TAIL: u64 = 1 + 8 + 20 + 8;
-    let mut file = File::open(path).map_err(io_err(path, "open"))?;
+    let mut file = open_own_file(path)?;
     let len = file.metadata().map_err(io_err(path, "stat"))?.len();
     if len < 8 + TAIL {
         return Ok(false);
@@ -122,7 +155,13 @@ pub fn is_finished(path: &Path) -> Result<bool> {
 /// Recovers one unfinished file as the module docs say: rewritten from its complete records
 /// (the copy checked strictly before it replaces the original), or quarantined.
 pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
-    let original_bytes = std::fs::metadata(path).map_err(io_err(path, "stat"))?.len();
+    let original = match own_regular_file(path) {
+        Ok(meta) => meta,
+        Err(not_own) => return Ok(skipped(not_own)),
+    };
+    let original_bytes = original.len();
+    // The copy keeps the original's mode, never wider than 0640.
+    let copy_mode = std::os::unix::fs::PermissionsExt::mode(&original.permissions()) & FILE_MODE;
     let report = |action, messages_recovered, outcome: &ScanOutcome, problem| RecoveryReport {
         path: path.to_path_buf(),
         messages_recovered,
@@ -143,7 +182,7 @@ pub fn recover_file(path: &Path) -> Result<RecoveryReport> {
     let mut temp_name = path.as_os_str().to_owned();
     temp_name.push(TEMP_SUFFIX);
     let temp = PathBuf::from(temp_name);
-    let copied = copy_readable_records(path, &temp);
+    let copied = copy_readable_records(path, &temp, copy_mode);
     let (copy, outcome) = match copied {
         Ok(c) => c,
         Err(e) => {
@@ -225,14 +264,15 @@ struct Copied {
     orphans: u64,
 }
 
-/// Writes every readable record of `path` into a new finished file `temp`, fsynced.
-fn copy_readable_records(path: &Path, temp: &Path) -> Result<(Copied, ScanOutcome)> {
+/// Writes every readable record of `path` into a new finished file `temp` (created with
+/// `mode`, never through a link), fsynced.
+fn copy_readable_records(path: &Path, temp: &Path, mode: u32) -> Result<(Copied, ScanOutcome)> {
     let werr = |source| McapLogError::Write {
         path: temp.to_path_buf(),
         source,
     };
     let mut scanner = Scanner::open(path)?;
-    let file = File::create(temp).map_err(io_err(temp, "create"))?;
+    let file = create_new_with_mode(temp, mode).map_err(io_err(temp, "create"))?;
     let mut writer = WriteOptions::new()
         .profile("")
         .library(concat!("bearingd ", env!("CARGO_PKG_VERSION"), " recovery"))
@@ -323,21 +363,30 @@ fn copy_readable_records(path: &Path, temp: &Path) -> Result<(Copied, ScanOutcom
 /// name not yet taken there; returns the new path.
 fn quarantine(path: &Path, keep_link: bool) -> Result<PathBuf> {
     let dir = parent_dir(path).join(QUARANTINE_DIR);
-    std::fs::create_dir_all(&dir).map_err(io_err(&dir, "create the quarantine directory"))?;
+    crate::fsafe::create_dir_all(&dir).map_err(io_err(&dir, "create the quarantine directory"))?;
+    // A link named `quarantine` would send the files elsewhere.
+    match std::fs::symlink_metadata(&dir) {
+        Ok(meta) if meta.is_dir() => {}
+        _ => {
+            return Err(io_err(&dir, "use the quarantine directory")(
+                std::io::Error::other("not a directory (a link?); remove it"),
+            ))
+        }
+    }
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "unnamed".into());
     let mut to = dir.join(&name);
     let mut n = 1;
-    while to.exists() {
+    while std::fs::symlink_metadata(&to).is_ok() {
         to = dir.join(format!("{name}.{n}"));
         n += 1;
     }
     if keep_link {
         // A file system without hard links gets a copy.
         if std::fs::hard_link(path, &to).is_err() {
-            std::fs::copy(path, &to).map_err(io_err(&to, "keep the original in quarantine"))?;
+            copy_own_file(path, &to).map_err(io_err(&to, "keep the original in quarantine"))?;
         }
     } else {
         std::fs::rename(path, &to).map_err(io_err(&to, "move into quarantine"))?;
@@ -347,17 +396,18 @@ fn quarantine(path: &Path, keep_link: bool) -> Result<PathBuf> {
     Ok(to)
 }
 
-fn parent_dir(path: &Path) -> &Path {
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => dir,
-        _ => Path::new("."),
-    }
+/// Copies this user's regular file `from` to the new name `to`, never through a link, with
+/// `from`'s mode (at most 0640).
+fn copy_own_file(from: &Path, to: &Path) -> std::io::Result<()> {
+    let mut source = open_own_file(from).map_err(std::io::Error::other)?;
+    let mode = std::os::unix::fs::PermissionsExt::mode(&source.metadata()?.permissions());
+    let mut copy = create_new_with_mode(to, mode & FILE_MODE)?;
+    std::io::copy(&mut source, &mut copy)?;
+    copy.sync_all()
 }
 
 /// Makes a rename in `path`'s directory durable; a directory that cannot be opened for fsync
 /// is not fatal.
 pub(super) fn sync_parent(path: &Path) {
-    if let Ok(d) = File::open(parent_dir(path)) {
-        let _ = d.sync_all();
-    }
+    crate::fsafe::sync_dir(parent_dir(path));
 }

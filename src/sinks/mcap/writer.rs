@@ -12,7 +12,7 @@
 //! time to wall time), so that tests stay deterministic.
 
 use std::collections::{BTreeMap, HashMap};
-use std::fs::{File, OpenOptions};
+use std::fs::File;
 use std::io::{self, BufWriter, Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -21,6 +21,7 @@ use std::sync::Arc;
 use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions};
 
+use crate::fsafe::{check_own_regular, NotOwnFile};
 use crate::mcap_log::error::{io_err, McapLogError, Result};
 use crate::mcap_log::files::{file_name, is_log_file_name};
 use crate::mcap_log::schema::{self, encode, JsonKind, RAW_BLOCK_SCHEMA};
@@ -133,6 +134,9 @@ pub struct RetentionReport {
     pub bytes_deleted: u64,
     /// Bytes of `bearingd-*.mcap` files left in the directory, the open file included.
     pub total_bytes_after: u64,
+    /// Log-named entries that are not this user's regular files (a link, a directory, another
+    /// user's file): neither counted nor deleted.
+    pub skipped: Vec<NotOwnFile>,
 }
 
 /// Tracks the logical position and length of a seekable stream, so the open file's size is
@@ -225,7 +229,7 @@ impl OpenFile {
         let (path, file) = loop {
             let path = dir.join(file_name(opened_at_ns, *seq));
             *seq = seq.wrapping_add(1);
-            match OpenOptions::new().write(true).create_new(true).open(&path) {
+            match crate::fsafe::create_new(&path) {
                 Ok(f) => break (path, f),
                 Err(e) if e.kind() == io::ErrorKind::AlreadyExists && tries < 10_000 => tries += 1,
                 Err(e) => return Err(io_err(&path, "create")(e)),
@@ -430,7 +434,8 @@ impl McapLogger {
     /// crash is recovered there, not here.
     pub fn create(config: LoggerConfig, opened_at_ns: u64) -> Result<Self> {
         config.check()?;
-        std::fs::create_dir_all(&config.dir).map_err(io_err(&config.dir, "create directory"))?;
+        crate::fsafe::create_dir_all(&config.dir)
+            .map_err(io_err(&config.dir, "create directory"))?;
         super::recover::sync_parent(&config.dir);
         let mut logger = McapLogger {
             config,
@@ -685,6 +690,7 @@ impl McapLogger {
 /// Retention over a directory: see [`McapLogger::apply_retention`].
 pub fn enforce_budget(dir: &Path, budget: u64, open: Option<&Path>) -> Result<RetentionReport> {
     let mut files: Vec<(String, PathBuf, u64)> = Vec::new();
+    let mut report = RetentionReport::default();
     let entries = std::fs::read_dir(dir).map_err(io_err(dir, "list directory"))?;
     for entry in entries {
         let entry = entry.map_err(io_err(dir, "list directory"))?;
@@ -693,9 +699,15 @@ pub fn enforce_budget(dir: &Path, budget: u64, open: Option<&Path>) -> Result<Re
             continue;
         }
         let path = entry.path();
+        // The entry's own metadata: a link is seen as a link, never followed.
         let len = match entry.metadata() {
-            Ok(m) if m.is_file() => m.len(),
-            Ok(_) => continue,
+            Ok(m) => match check_own_regular(&path, m) {
+                Ok(m) => m.len(),
+                Err(not_own) => {
+                    report.skipped.push(not_own);
+                    continue;
+                }
+            },
             // Deleted meanwhile (another pass): nothing to count.
             Err(e) if e.kind() == io::ErrorKind::NotFound => continue,
             Err(e) => return Err(io_err(&path, "stat")(e)),
@@ -704,7 +716,6 @@ pub fn enforce_budget(dir: &Path, budget: u64, open: Option<&Path>) -> Result<Re
     }
     files.sort();
     let mut total: u64 = files.iter().map(|f| f.2).sum();
-    let mut report = RetentionReport::default();
     for (_, path, len) in &files {
         if total <= budget {
             break;
