@@ -12,6 +12,7 @@ use crate::daemon::events::{DaemonEvent, Events};
 use crate::daemon::lock::DirLock;
 use crate::daemon::{replay, BaselinesFrom, ReplayOptions, ReplaySummary, RunStart};
 use crate::mcap_log::files::utc_text;
+use crate::mcap_log::LogHeader;
 use crate::pipeline::{Sink, SinkError};
 use crate::sinks::mcap::McapSink;
 use crate::sources::replay::plan::{differences, file_list, LoggedSettings, ReplayPlan};
@@ -74,6 +75,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
         check_mcap_magic(file)?;
     }
     let plan = ReplayPlan::new(&args.files).map_err(CliError::input)?;
+    plan.files.iter().try_for_each(check_holds_a_message)?;
     if plan.reordered {
         eprintln!(
             "bearingd: replay: reading the files by run and sequence, not in the order given: {}",
@@ -400,5 +402,19 @@ fn check_mcap_magic(file: &Path) -> Result<(), CliError> {
              written by `bearingd run` or `bearingd import` (a .mcap file)",
             file.display()
         ))),
+    }
+}
+
+/// Refuses a file from which not one message could be read because reading stopped on a
+/// defect (random bytes after the magic, a hostile length, a cut before the first chunk):
+/// replaying it would succeed with 0 blocks, which looks like an empty log rather than a broken
+/// file. A complete log that simply holds no message is replayed (it says so: 0 blocks).
+fn check_holds_a_message(header: &LogHeader) -> Result<(), CliError> {
+    match header.no_message_reason() {
+        Some(why) => Err(CliError::input(format!(
+            "{}: {why}; leave it out of the replay",
+            header.path.display()
+        ))),
+        None => Ok(()),
     }
 }

@@ -45,9 +45,23 @@ pub struct LogHeader {
     pub version: Option<String>,
     /// The health baselines the run started with, as JSON (`bearingd.state`).
     pub start_baselines_json: Option<String>,
+    /// At least one message could be read (reading stops at the first).
+    pub holds_a_message: bool,
+    /// Where and why reading stopped, or first skipped something, before the first message.
+    pub problem: Option<(u64, String)>,
 }
 
 impl LogHeader {
+    /// Why not one message could be read, when reading stopped on a defect before the first
+    /// ([`super::reader::no_message_reason`]); `None` for a file with messages or a complete
+    /// log that holds none.
+    pub fn no_message_reason(&self) -> Option<String> {
+        self.problem
+            .as_ref()
+            .filter(|_| !self.holds_a_message)
+            .map(super::reader::no_message_reason)
+    }
+
     /// Does the file carry the run's metadata (run id and config)?
     pub fn is_self_describing(&self) -> bool {
         self.run_id.is_some() && self.config_json.is_some()
@@ -65,10 +79,14 @@ pub fn read_header(path: &Path) -> Result<LogHeader> {
     while let Some(record) = scanner.next_record()? {
         match record {
             ScannedRecord::Metadata { name, metadata } => header.take(&name, &metadata),
-            ScannedRecord::Message { .. } => break,
+            ScannedRecord::Message { .. } => {
+                header.holds_a_message = true;
+                break;
+            }
             ScannedRecord::Schema { .. } | ScannedRecord::Channel { .. } => {}
         }
     }
+    header.problem = scanner.outcome().first_problem.clone();
     Ok(header)
 }
 

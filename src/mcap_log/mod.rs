@@ -11,12 +11,14 @@
 //!   encoding of every message and its decoding live side by side (`schema.rs`, `reader.rs`).
 //! - replay must read whatever survived, never panic, and say what it could not read: one
 //!   bounded scanner (`scan.rs`) under both the reader (`reader.rs`) and the sink's start-up
-//!   recovery.
+//!   recovery. No declared length is allocated before it is known to fit in the file and in
+//!   its record (`bounds.rs`, used by every reader: a hostile file must not abort the daemon).
 //! - no clock inside: the caller passes every timestamp, so tests and replays are
 //!   deterministic.
 //! - a file that replaces another (recovery) must first pass a strict read by the `mcap`
 //!   crate's own reader (`verify.rs`), independent of the scanner that produced it.
 
+pub mod bounds;
 pub(crate) mod error;
 pub mod files;
 pub mod header;
@@ -29,8 +31,8 @@ pub use error::{McapLogError, Result};
 pub use files::{file_name, is_log_file_name};
 pub use header::{read_header, LogHeader};
 pub use reader::{
-    read_messages, read_raw_blocks, FileReadReport, LogReader, LoggedMessage, RawBlocks,
-    ReadSummary,
+    no_message_reason, read_messages, read_raw_blocks, FileReadReport, LogReader, LoggedMessage,
+    RawBlocks, ReadSummary,
 };
 pub use scan::ScanOutcome;
 pub use verify::{read_back_strictly, StrictRead};

@@ -37,6 +37,28 @@ pub struct FileReadReport {
     pub open_failed: bool,
 }
 
+impl FileReadReport {
+    /// Why not one message came out of the file, when reading stopped on a defect (see
+    /// [`no_message_reason`]); `None` when it yielded messages or is a complete empty log.
+    pub fn no_message_reason(&self) -> Option<String> {
+        let nothing = self.messages == 0 && self.undecodable_messages == 0;
+        self.scan
+            .first_problem
+            .as_ref()
+            .filter(|_| nothing)
+            .map(no_message_reason)
+    }
+}
+
+/// The words for a file from which not one message could be read because reading stopped on
+/// a defect at `offset`: said the same by `replay` and `analyze`.
+pub fn no_message_reason((offset, why): &(u64, String)) -> String {
+    format!(
+        "no message could be read: reading stopped at byte {offset} ({why}); the file is not a \
+         bearingd log or is truncated before its first message"
+    )
+}
+
 /// Totals over every file read.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ReadSummary {

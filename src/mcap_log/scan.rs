@@ -4,11 +4,12 @@
 //! reading stopped and how many bytes were lost, to read a file that is still truncated, and to
 //! hold at most one chunk in memory. So this walks the top-level records itself (opcode, length,
 //! body: the MCAP framing), checks every length against what is left of the file and a hard
-//! limit before allocating, decompresses each chunk itself with the output bounded by the
-//! declared size, checks the chunk's CRC, and only then parses the records in it with
-//! `mcap::parse_record`. (The crate's `ChunkReader` trusts inner record lengths before the CRC
-//! is checked and can be made to allocate without bound by a flipped byte.) A chunk is taken
-//! whole or not at all.
+//! limit before allocating ([`super::bounds`]), decompresses each chunk itself with the output
+//! bounded by the declared size, checks the chunk's CRC, and only then parses the records in it
+//! with [`super::bounds::parse_record`], which checks every length inside a record first. (The
+//! crate's `ChunkReader` trusts inner record lengths before the CRC is checked, and its record
+//! parser reserves a string's declared length, up to 4 GiB, before reading it.) A chunk is
+//! taken whole or not at all.
 //!
 //! A chunk that fails (bad CRC, bad compression) but whose framing is intact is skipped and
 //! counted; a record whose framing is broken (a length past the end of the file: the open chunk
@@ -21,11 +22,9 @@ use std::path::{Path, PathBuf};
 
 use mcap::records::Record;
 
+pub use super::bounds::MAX_RECORD_BYTES;
+use super::bounds::{parse_record, record_length_limit};
 use super::error::{io_err, McapLogError, Result};
-
-/// No record or chunk larger than this is ever read into memory (the logger writes chunks of a
-/// few MiB; anything larger is corruption).
-pub const MAX_RECORD_BYTES: u64 = 64 * 1024 * 1024;
 
 const OP_DATA_END: u8 = 0x0F;
 const OP_FOOTER: u8 = 0x02;
@@ -194,15 +193,13 @@ impl Scanner {
         len_bytes.copy_from_slice(&head[1..]);
         let len = u64::from_le_bytes(len_bytes);
         let remaining = self.file_len.saturating_sub(start + 9);
-        if len > remaining {
-            self.stop(start, format!("record (opcode {opcode:#04x}) of {len} bytes runs past the end of the file ({remaining} bytes left): truncated"));
-            return Ok(());
-        }
-        if len > MAX_RECORD_BYTES {
-            self.stop(
-                start,
-                format!("record of {len} bytes exceeds the {MAX_RECORD_BYTES}-byte limit"),
-            );
+        if len > record_length_limit(remaining) {
+            let why = if len > remaining {
+                format!("record (opcode {opcode:#04x}) of {len} bytes runs past the end of the file ({remaining} bytes left): truncated")
+            } else {
+                format!("record of {len} bytes exceeds the {MAX_RECORD_BYTES}-byte limit")
+            };
+            self.stop(start, why);
             return Ok(());
         }
         let mut body = vec![0u8; len as usize];
@@ -282,8 +279,7 @@ fn own(opcode: u8, body: &[u8], offset: u64) -> std::result::Result<Option<Scann
     if !matches!(opcode, OP_SCHEMA | OP_CHANNEL | OP_MESSAGE | OP_METADATA) {
         return Ok(None);
     }
-    let record = mcap::parse_record(opcode, body)
-        .map_err(|e| format!("record (opcode {opcode:#04x}): {e}"))?;
+    let record = parse_record(opcode, body)?;
     Ok(match record {
         Record::Schema { header, data } => Some(ScannedRecord::Schema {
             id: header.id,

@@ -3,6 +3,8 @@
 //! summary section CRCs, the footer, and the statistics record's message count against the
 //! messages actually found.
 //!
+//! Record lengths are bounded as in every reader ([`super::bounds`]).
+//!
 //! Why a second reader beside [`super::scan`]: recovery writes a copy from what the scanner
 //! read; before that copy may replace anything it must pass a reader that did not produce it,
 //! with nothing forgiven (the scanner is deliberately lenient, this one is not).
@@ -14,8 +16,8 @@ use std::path::Path;
 use mcap::records::Record;
 use mcap::sans_io::{LinearReadEvent, LinearReader, LinearReaderOptions};
 
+use super::bounds::{parse_record, MAX_RECORD_BYTES};
 use super::error::{io_err, McapLogError, Result};
-use super::scan::MAX_RECORD_BYTES;
 
 /// What a strict read found in a file that passed it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -33,6 +35,8 @@ pub fn read_back_strictly(path: &Path) -> Result<StrictRead> {
         .with_validate_data_section_crc(true)
         .with_validate_summary_section_crc(true)
         .with_check_finishes_after_end_magic(true)
+        // The crate applies this limit to a chunk's uncompressed records too, which may be
+        // larger than the file itself: the cap, not the file's size.
         .with_record_length_limit(MAX_RECORD_BYTES as usize);
     let mut reader = LinearReader::new_with_options(options);
     let mut found = StrictRead::default();
@@ -53,9 +57,7 @@ pub fn read_back_strictly(path: &Path) -> Result<StrictRead> {
                 offset += read as u64;
             }
             LinearReadEvent::Record { data, opcode } => {
-                match mcap::parse_record(opcode, data)
-                    .map_err(|e| corrupt(offset, e.to_string()))?
-                {
+                match parse_record(opcode, data).map_err(|e| corrupt(offset, e))? {
                     Record::Message { .. } => found.messages += 1,
                     Record::ChunkIndex(_) => found.chunks += 1,
                     Record::Statistics(s) => statistics = Some(s.message_count),

@@ -178,6 +178,17 @@ pub(super) fn read(path: &Path, selector: Option<&str>) -> Result<Recording, Rec
         }
     }
     let Some(j) = joined else {
+        let unreadable = reader
+            .summary()
+            .files
+            .iter()
+            .find_map(|f| f.no_message_reason());
+        if let Some(why) = unreadable {
+            return Err(RecordingError::BadLog {
+                path: path.to_path_buf(),
+                detail: format!("{why}; analyse a log written by bearingd run or import"),
+            });
+        }
         if let (Some(e), true) = (&first_error, others.is_empty()) {
             return Err(bad_log(path, e));
         }

@@ -13,6 +13,7 @@ mod evaluate_recordings;
 mod fleet;
 mod formats;
 mod hostile_files;
+mod hostile_logs;
 mod kinematics;
 mod learned;
 mod monitor;

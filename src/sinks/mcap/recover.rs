@@ -8,7 +8,10 @@
 //! How, for each unfinished `bearingd-*.mcap`:
 //! - nothing in it can be read (not MCAP at all, or not one record: a random file named like a
 //!   log, a file cut before its first chunk) → it is **moved to `quarantine/`** beside the logs,
-//!   untouched, and the report says why. An empty (0-byte) file holds nothing and is removed.
+//!   untouched, and the report says why; no copy is started for it, and no length it declares
+//!   is allocated (every read is bounded: [`crate::mcap_log::bounds`]), so a hostile file can
+//!   neither abort the start nor be met again by the next one. An empty (0-byte) file holds
+//!   nothing and is removed.
 //! - otherwise the readable records are copied to `<name>.recovering`, fsynced, and the copy is
 //!   **read back strictly** by the `mcap` crate's own reader
 //!   ([`crate::mcap_log::read_back_strictly`]: every CRC, the summary, the message count). Only
@@ -271,7 +274,17 @@ fn copy_readable_records(path: &Path, temp: &Path, mode: u32) -> Result<(Copied,
         path: temp.to_path_buf(),
         source,
     };
+    let mut copied = Copied {
+        records: 0,
+        messages: 0,
+        orphans: 0,
+    };
     let mut scanner = Scanner::open(path)?;
+    // The copy is created only once there is something to copy: a file with not one readable
+    // record (a hostile or random file) is quarantined with nothing written beside it.
+    let Some(first) = scanner.next_record()? else {
+        return Ok((copied, scanner.outcome().clone()));
+    };
     let file = create_new_with_mode(temp, mode).map_err(io_err(temp, "create"))?;
     let mut writer = WriteOptions::new()
         .profile("")
@@ -281,12 +294,11 @@ fn copy_readable_records(path: &Path, temp: &Path, mode: u32) -> Result<(Copied,
         .map_err(werr)?;
     let mut schema_ids: HashMap<u16, u16> = HashMap::new();
     let mut channel_ids: HashMap<u16, u16> = HashMap::new();
-    let mut copied = Copied {
-        records: 0,
-        messages: 0,
-        orphans: 0,
-    };
-    while let Some(record) = scanner.next_record()? {
+    let mut first = Some(first);
+    while let Some(record) = match first.take() {
+        Some(record) => Some(record),
+        None => scanner.next_record()?,
+    } {
         match record {
             ScannedRecord::Schema {
                 id,
