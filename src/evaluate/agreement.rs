@@ -108,7 +108,7 @@ pub fn tally(results: &[CaseResult]) -> Vec<PointTally> {
 }
 
 /// The grid as a table, best first: clean points (no false alarm, nothing named wrong) by
-/// faults named right, then the rest; with the envelope alone's count for comparison.
+/// faults named right, then the rest; with the configured decision's count for comparison.
 pub fn render(results: &[CaseResult]) -> String {
     let witnessed = results
         .iter()
@@ -118,7 +118,7 @@ pub fn render(results: &[CaseResult]) -> String {
                 .is_ok_and(|o| !o.agreement_grid.is_empty())
         })
         .collect::<Vec<_>>();
-    let envelope_right = witnessed
+    let configured_right = witnessed
         .iter()
         .filter(|r| {
             r.truth()
@@ -147,7 +147,8 @@ pub fn render(results: &[CaseResult]) -> String {
     });
     let mut out = format!(
         "Agreement grid, record path: {} records the model knows ({faulty} with a fault); \
-         the envelope alone names {envelope_right} right\n\n\
+         the configured decision (the envelope alone unless the config sets agreement_*) \
+         names {configured_right} right\n\n\
          | probability | score | lead | relief (decades) | named right | false alarms | confident wrong |\n\
          |---|---|---|---|---|---|---|\n",
         witnessed.len()
@@ -167,4 +168,31 @@ pub fn render(results: &[CaseResult]) -> String {
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::record::RecordAnalyzer;
+    use crate::twin::{SimulatedFault, SimulationParams, Simulator};
+
+    #[test]
+    fn the_grid_holds_each_point_once_and_without_an_opinion_every_point_is_the_envelope() {
+        let points = grid();
+        assert_eq!(points.len(), 96);
+        let distinct: std::collections::BTreeSet<String> =
+            points.iter().map(|p| format!("{p:?}")).collect();
+        assert_eq!(distinct.len(), points.len());
+        let params = SimulationParams::example(SimulatedFault::OuterRace);
+        let signal = Simulator::record(params.clone(), 4.0);
+        let settings = AnalysisSettings::default();
+        let analysis = RecordAnalyzer::default()
+            .analyze(&signal, params.fs_hz, &params.frequencies(), &settings)
+            .expect("the example record analyses");
+        let envelope = Predicted::of_verdict(analysis.diagnosis.verdict);
+        assert_eq!(envelope, Predicted::Fault(crate::messages::FaultKind::OuterRace));
+        let verdicts = grid_verdicts(&analysis, &settings, None);
+        assert_eq!(verdicts.len(), points.len());
+        assert!(verdicts.iter().all(|&v| v == envelope), "{verdicts:?}");
+    }
 }
