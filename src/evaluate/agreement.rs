@@ -190,7 +190,10 @@ mod tests {
             .analyze(&signal, params.fs_hz, &params.frequencies(), &settings)
             .expect("the example record analyses");
         let envelope = Predicted::of_verdict(analysis.diagnosis.verdict);
-        assert_eq!(envelope, Predicted::Fault(crate::messages::FaultKind::OuterRace));
+        assert_eq!(
+            envelope,
+            Predicted::Fault(crate::messages::FaultKind::OuterRace)
+        );
         let verdicts = grid_verdicts(&analysis, &settings, None);
         assert_eq!(verdicts.len(), points.len());
         assert!(verdicts.iter().all(|&v| v == envelope), "{verdicts:?}");
