@@ -6,7 +6,7 @@
 
 use bearingd::mcap_log::read_messages;
 use bearingd::messages::PipelineMessage;
-use bearingd_testdata::{check_mcap_with_python, mcap_files, python_mcap, scratch_dir};
+use bearingd_testdata::{check_mcap_with_python, mcap_files, noise, python_mcap, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -129,18 +129,6 @@ fn the_lock_of_a_daemon_killed_with_sigkill_is_taken_over_and_said() {
         stderr.contains("taken over") && stderr.contains(&format!("pid={pid} ")),
         "{stderr}"
     );
-}
-
-/// A deterministic pseudo-random byte stream (xorshift), for files that are not logs.
-fn noise(len: usize, mut seed: u64) -> Vec<u8> {
-    (0..len)
-        .map(|_| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed as u8
-        })
-        .collect()
 }
 
 #[test]

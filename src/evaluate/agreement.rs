@@ -11,7 +11,7 @@
 
 use super::run::{CaseResult, Predicted};
 use super::summary::is_confident_wrong;
-use crate::analysis::agreement::{Agreement, WitnessOpinion};
+use crate::analysis::agreement::{decide, Agreement, WitnessOpinion};
 use crate::analysis::record::RecordAnalysis;
 use crate::analysis::AnalysisSettings;
 use std::fmt::Write as _;
@@ -50,16 +50,20 @@ pub fn grid_verdicts(
     settings: &AnalysisSettings,
     opinion: Option<WitnessOpinion>,
 ) -> Vec<Predicted> {
+    let scores = analysis.scores();
+    let rule = settings.decision_rule();
     grid()
         .into_iter()
         .map(|agreement| {
-            let mut decided = analysis.clone();
-            let at_point = AnalysisSettings {
-                agreement: Some(agreement),
-                ..settings.clone()
-            };
-            decided.hear_witness(opinion, &at_point);
-            Predicted::of_verdict(decided.diagnosis.verdict)
+            let decided = decide(
+                &scores,
+                &analysis.explained,
+                &analysis.diagnosis,
+                &rule,
+                &agreement,
+                opinion,
+            );
+            Predicted::of_verdict(decided.verdict)
         })
         .collect()
 }

@@ -3,23 +3,13 @@
 //! file of its own with known content, runs the real `bearingd` binary as a second process,
 //! and checks that the victim is untouched and that what the daemon says names the path.
 
+use crate::cli::{bearingd, stderr as stderr_of};
 use bearingd_testdata::{iox_root, mcap_files, scratch_dir};
 use std::os::unix::fs::{symlink, PermissionsExt};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 const VICTIM_TEXT: &str = "victim: nobody may write, truncate or print this\n";
-
-fn bearingd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bearingd"))
-        .args(args)
-        .output()
-        .expect("run bearingd")
-}
-
-fn stderr_of(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
 
 /// A file of the test's, mode 0600, that no bearingd may change.
 fn victim(dir: &Path) -> PathBuf {

@@ -5,8 +5,9 @@
 //! the file (exit 2, never an abort), read the cut log as far as it is valid, and the daemon's
 //! start-up recovery must quarantine them, leave no `.recovering` copy and release its lock.
 
+use crate::cli::stderr as stderr_of;
 use bearingd::mcap_log::read_raw_blocks;
-use bearingd_testdata::{iox_root, mcap_files, scratch_dir};
+use bearingd_testdata::{iox_root, mcap_files, noise, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -32,10 +33,6 @@ fn bearingd_limited(args: &[&str]) -> Output {
     out
 }
 
-fn stderr_of(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
 /// An MCAP record: opcode, the declared length (u64 LE), the body.
 fn record(opcode: u8, declared_len: u64, body: &[u8]) -> Vec<u8> {
     let mut out = vec![opcode];
@@ -57,18 +54,6 @@ fn mcap_start() -> Vec<u8> {
     let mut out = mcap::MAGIC.to_vec();
     out.extend(record(0x01, header.len() as u64, &header));
     out
-}
-
-/// A deterministic pseudo-random byte stream (xorshift).
-fn noise(len: usize, mut seed: u64) -> Vec<u8> {
-    (0..len)
-        .map(|_| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            seed as u8
-        })
-        .collect()
 }
 
 /// (file name, bytes) of the three files from which nothing may be read.

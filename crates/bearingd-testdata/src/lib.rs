@@ -216,3 +216,15 @@ pub fn check_mcap_with_python(
     );
     serde_json::from_slice(&out.stdout).expect("summary JSON")
 }
+
+/// A deterministic pseudo-random byte stream (xorshift), for files that are not logs.
+pub fn noise(len: usize, mut seed: u64) -> Vec<u8> {
+    (0..len)
+        .map(|_| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed as u8
+        })
+        .collect()
+}
