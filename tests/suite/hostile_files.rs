@@ -10,14 +10,14 @@ use std::process::{Command, Output};
 
 const VICTIM_TEXT: &str = "victim: nobody may write, truncate or print this\n";
 
-fn bearingd(args: &[&str]) -> Output {
+pub(super) fn bearingd(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_bearingd"))
         .args(args)
         .output()
         .expect("run bearingd")
 }
 
-fn stderr_of(out: &Output) -> String {
+pub(super) fn stderr_of(out: &Output) -> String {
     String::from_utf8_lossy(&out.stderr).into_owned()
 }
 
@@ -44,7 +44,7 @@ fn mode_of(path: &Path) -> u32 {
 }
 
 /// The default config with an iceoryx2 root of the test's own, in `dir/config.toml`.
-fn config(dir: &Path, tag: &str) -> PathBuf {
+pub(super) fn config(dir: &Path, tag: &str) -> PathBuf {
     let out = bearingd(&["config", "default"]);
     assert!(out.status.success(), "{}", stderr_of(&out));
     let root = iox_root(env!("CARGO_TARGET_TMPDIR"), tag);
@@ -60,7 +60,7 @@ fn config(dir: &Path, tag: &str) -> PathBuf {
 
 /// `bearingd run` of `config` on `data`, 2 s of simulated signal as fast as it goes, under
 /// `umask` (the shell sets it, then execs the binary).
-fn run_daemon(config: &Path, data: &Path, umask: &str) -> Output {
+pub(super) fn run_daemon(config: &Path, data: &Path, umask: &str) -> Output {
     Command::new("sh")
         .arg("-c")
         .arg(format!("umask {umask}; exec \"$0\" \"$@\""))
