@@ -92,3 +92,70 @@ fn the_daemons_own_0750_root_is_tightened_to_0700_and_the_run_goes_on() {
     assert_eq!(mcap_files(&data.join("mcap")).len(), 1);
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// Another user (uid 61032, `$BEARINGD_TEST_OTHER_UID` to change it) creates the root first,
+/// mode 0777, in a sticky directory both may write (as /dev/shm is): the daemon refuses it,
+/// naming the owner and the fix, and leaves no log. Needs root to act as the other user.
+#[test]
+fn a_root_another_user_made_first_is_refused_naming_its_owner() {
+    if !is_root() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "this test needs root (setpriv to another uid); run the suite as root"
+        );
+        eprintln!("skipped: not root, cannot act as another user");
+        return;
+    }
+    let other: u32 = std::env::var("BEARINGD_TEST_OTHER_UID")
+        .ok()
+        .and_then(|u| u.parse().ok())
+        .unwrap_or(61032);
+    let dir = scratch_dir("hostile-root-foreign");
+    let config = config(&dir, "hrf");
+    let shared = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrf");
+    let _ = std::fs::remove_dir_all(&shared);
+    std::fs::create_dir_all(&shared).unwrap();
+    std::fs::set_permissions(&shared, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    let root = shared.join("r");
+    let made = std::process::Command::new("setpriv")
+        .args([&format!("--reuid={other}"), &format!("--regid={other}")])
+        .args(["--clear-groups", "--", "mkdir", "-m", "0777"])
+        .arg(&root)
+        .status()
+        .expect("run setpriv (util-linux)");
+    assert!(
+        made.success(),
+        "uid {other} could not create {}",
+        root.display()
+    );
+    let text = std::fs::read_to_string(&config).unwrap().replace(
+        &format!("\"{}\"", shared.display()),
+        &format!("\"{}\"", root.display()),
+    );
+    std::fs::write(&config, text).unwrap();
+    let root_text = root.display().to_string();
+    refused_twice(
+        &config,
+        &dir.join("data"),
+        &[
+            &root_text,
+            &format!("owned by uid {other}"),
+            &format!("rm -r {root_text} as root"),
+        ],
+    );
+    assert_eq!(
+        std::fs::read_dir(&root).unwrap().count(),
+        0,
+        "iceoryx2 used it"
+    );
+    std::fs::remove_dir_all(&shared).unwrap();
+}
+
+fn is_root() -> bool {
+    let status = std::fs::read_to_string("/proc/self/status").unwrap();
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("Uid:"))
+        .and_then(|ids| ids.split_whitespace().nth(1))
+        == Some("0")
+}
