@@ -7,7 +7,7 @@ A gateway, an HMI or a maintenance script can start from this. It mirrors the da
 
     pip install iceoryx2==0.10.0
     python3 examples/alerts_subscriber.py --root /run/bearingd/iceoryx2        # the service
-    python3 examples/alerts_subscriber.py --root /tmp/bearingd-iox-...         # `bearingd run`
+    python3 examples/alerts_subscriber.py --root $XDG_RUNTIME_DIR/bearingd-iox-...  # `bearingd run`
                                         # without a config: the root it prints at start
 
 It prints the alerts active when it subscribes (the service keeps them in its history), then

@@ -219,6 +219,14 @@ pub enum UnsafeDir {
         path: PathBuf,
         source: std::io::Error,
     },
+    #[error("iceoryx2 root {path}: is a symbolic link; bearingd does not follow it (someone may point it at a directory of theirs); fix: rm {path}")]
+    Symlink { path: PathBuf },
+    #[error("iceoryx2 root {path}: is not a directory; fix: rm {path} (after looking at what it is), or set outputs.iceoryx2_root")]
+    NotDir { path: PathBuf },
+    #[error("iceoryx2 root {path}: owned by uid {owner}, not by bearingd's uid {uid}; another user may have made it to read or forge alerts; fix: rm -r {path} as root, or set outputs.iceoryx2_root")]
+    ForeignRoot { path: PathBuf, owner: u32, uid: u32 },
+    #[error("iceoryx2 root {path}: mode {mode:04o} lets other users write in it (they may have planted services); fix: check `ls -lnR {path}`, then rm -r {path}")]
+    TooOpen { path: PathBuf, mode: u32 },
 }
 
 /// Refuses a data directory other users could write into (as ssh's `StrictModes`): `dir` must
@@ -240,28 +248,41 @@ pub fn check_private_dir(dir: &Path) -> Result<(), UnsafeDir> {
             uid,
         });
     }
-    let writable_by_others = |meta: &Metadata| meta.permissions().mode() & 0o002 != 0;
     if writable_by_others(&meta) {
         return Err(UnsafeDir::WorldWritable {
             path: dir.to_path_buf(),
             mode: meta.permissions().mode() & 0o7777,
         });
     }
-    let parent = match dir.parent() {
+    match parent_of(dir) {
+        Some(parent) => check_parent(&parent, &stat(&parent)?),
+        None => Ok(()),
+    }
+}
+
+fn writable_by_others(meta: &Metadata) -> bool {
+    meta.permissions().mode() & 0o002 != 0
+}
+
+/// `dir`'s parent directory (through the current directory for a bare name).
+fn parent_of(dir: &Path) -> Option<PathBuf> {
+    match dir.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => Some(parent.to_path_buf()),
         _ => std::fs::canonicalize(dir)
             .ok()
             .and_then(|d| d.parent().map(Path::to_path_buf)),
-    };
-    if let Some(parent) = parent {
-        let meta = stat(&parent)?;
-        let sticky = meta.permissions().mode() & 0o1000 != 0;
-        if writable_by_others(&meta) && !sticky {
-            return Err(UnsafeDir::WorldWritable {
-                path: parent,
-                mode: meta.permissions().mode() & 0o7777,
-            });
-        }
+    }
+}
+
+/// The parent rule: others must not be able to rename a directory away (and put their own in
+/// its place), so its parent is not writable by others unless sticky (`/tmp`, `/dev/shm`).
+fn check_parent(parent: &Path, meta: &Metadata) -> Result<(), UnsafeDir> {
+    let sticky = meta.permissions().mode() & 0o1000 != 0;
+    if writable_by_others(meta) && !sticky {
+        return Err(UnsafeDir::WorldWritable {
+            path: parent.to_path_buf(),
+            mode: meta.permissions().mode() & 0o7777,
+        });
     }
     Ok(())
 }
@@ -274,6 +295,134 @@ pub fn prepare_private_dir(dir: &Path) -> Result<(), UnsafeDir> {
         source,
     })?;
     check_private_dir(dir)
+}
+
+/// Mode of the iceoryx2 root: iceoryx2 0.10 creates its files owner-only anyway, so nobody
+/// else has any business in it (issue 32).
+pub const PRIVATE_ROOT_MODE: u32 = 0o700;
+
+/// What [`prepare_private_root`] found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RootPrepared {
+    /// The root did not exist: made, [`PRIVATE_ROOT_MODE`].
+    Created,
+    /// Ours already, [`PRIVATE_ROOT_MODE`].
+    Ready,
+    /// Ours with group or other read bits (made by an earlier bearingd, or by iceoryx2 itself,
+    /// `0750`): tightened to [`PRIVATE_ROOT_MODE`].
+    Tightened { from: u32 },
+}
+
+/// Makes `root` the daemon's private iceoryx2 root, or says why it cannot be trusted (issue 32:
+/// another user who creates a predictable root first could read or forge every alert).
+///
+/// Its parent (created `0750` if missing) must pass [`check_private_dir`]'s parent rule and
+/// be owned by this user or root. `root` itself is created [`PRIVATE_ROOT_MODE`] when missing.
+/// An existing one is refused when it is a link (never followed), not a directory, owned by
+/// another user, or writable by group or others; this user's looser directory is tightened.
+/// The checks are made again on the directory opened without following a link, so a swap in
+/// between is caught.
+pub fn prepare_private_root(root: &Path) -> Result<RootPrepared, UnsafeDir> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| UnsafeDir::Io { path, source }
+    };
+    let uid = effective_uid();
+    if let Some(parent) = parent_of(root) {
+        create_dir_all(&parent).map_err(io(&parent))?;
+        let meta = std::fs::metadata(&parent).map_err(io(&parent))?;
+        if meta.uid() != uid && meta.uid() != 0 {
+            return Err(UnsafeDir::Foreign {
+                path: parent,
+                owner: meta.uid(),
+                uid,
+            });
+        }
+        check_parent(&parent, &meta)?;
+    }
+    let created = match std::fs::symlink_metadata(root) {
+        Ok(meta) => {
+            root_kind(root, &meta)?;
+            false
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            std::fs::DirBuilder::new()
+                .mode(PRIVATE_ROOT_MODE)
+                .create(root)
+                .map_err(io(root))?;
+            true
+        }
+        Err(e) => return Err(io(root)(e)),
+    };
+    let opened = OpenOptions::new()
+        .read(true)
+        .custom_flags(libc::O_DIRECTORY | libc::O_NOFOLLOW)
+        .open(root)
+        .map_err(|e| match e.raw_os_error() {
+            Some(libc::ELOOP) => UnsafeDir::Symlink {
+                path: root.to_path_buf(),
+            },
+            Some(libc::ENOTDIR) => UnsafeDir::NotDir {
+                path: root.to_path_buf(),
+            },
+            _ => io(root)(e),
+        })?;
+    let meta = opened.metadata().map_err(io(root))?;
+    check_root_owner_and_mode(root, &meta, uid)?;
+    let mode = meta.permissions().mode() & 0o7777;
+    if mode == PRIVATE_ROOT_MODE {
+        return Ok(if created {
+            RootPrepared::Created
+        } else {
+            RootPrepared::Ready
+        });
+    }
+    opened
+        .set_permissions(std::fs::Permissions::from_mode(PRIVATE_ROOT_MODE))
+        .map_err(io(root))?;
+    Ok(RootPrepared::Tightened { from: mode })
+}
+
+/// Checks, without changing anything, that `root` is a directory (not a link) owned by `uid`
+/// and not writable by group or others: what a subscriber expects of the daemon's root.
+pub fn check_private_root(root: &Path, uid: u32) -> Result<(), UnsafeDir> {
+    let meta = std::fs::symlink_metadata(root).map_err(|source| UnsafeDir::Io {
+        path: root.to_path_buf(),
+        source,
+    })?;
+    root_kind(root, &meta)?;
+    check_root_owner_and_mode(root, &meta, uid)
+}
+
+/// A link or a non-directory at the root's path is refused.
+fn root_kind(root: &Path, meta: &Metadata) -> Result<(), UnsafeDir> {
+    let path = root.to_path_buf();
+    if meta.file_type().is_symlink() {
+        Err(UnsafeDir::Symlink { path })
+    } else if !meta.is_dir() {
+        Err(UnsafeDir::NotDir { path })
+    } else {
+        Ok(())
+    }
+}
+
+/// The root must be `uid`'s and not writable by group or others.
+fn check_root_owner_and_mode(root: &Path, meta: &Metadata, uid: u32) -> Result<(), UnsafeDir> {
+    if meta.uid() != uid {
+        return Err(UnsafeDir::ForeignRoot {
+            path: root.to_path_buf(),
+            owner: meta.uid(),
+            uid,
+        });
+    }
+    let mode = meta.permissions().mode() & 0o7777;
+    if mode & 0o022 != 0 {
+        return Err(UnsafeDir::TooOpen {
+            path: root.to_path_buf(),
+            mode,
+        });
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -349,6 +498,91 @@ mod tests {
             .contains("chmod o-w"));
         std::fs::set_permissions(&open, std::fs::Permissions::from_mode(0o1777)).unwrap();
         check_private_dir(&inner).unwrap();
+    }
+
+    #[test]
+    fn a_private_root_is_made_0700_and_an_own_looser_one_tightened() {
+        let dir = scratch("root");
+        let root = dir.join("iox");
+        assert_eq!(prepare_private_root(&root).unwrap(), RootPrepared::Created);
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o7777;
+        assert_eq!(mode(&root), 0o700);
+        assert_eq!(prepare_private_root(&root).unwrap(), RootPrepared::Ready);
+        std::fs::set_permissions(&root, std::fs::Permissions::from_mode(0o750)).unwrap();
+        assert_eq!(
+            prepare_private_root(&root).unwrap(),
+            RootPrepared::Tightened { from: 0o750 }
+        );
+        assert_eq!(mode(&root), 0o700);
+        check_private_root(&root, effective_uid()).unwrap();
+        assert!(check_private_root(&root, effective_uid() + 1).is_err());
+    }
+
+    #[test]
+    fn a_root_that_is_a_link_a_file_or_open_to_others_is_refused_with_the_fix() {
+        let dir = scratch("badroot");
+        let victim = dir.join("victim");
+        create_dir_all(&victim).unwrap();
+        let link = dir.join("link");
+        std::os::unix::fs::symlink(&victim, &link).unwrap();
+        let err = prepare_private_root(&link).unwrap_err();
+        assert!(matches!(err, UnsafeDir::Symlink { .. }), "{err}");
+        assert!(err.to_string().contains(&format!("rm {}", link.display())));
+        assert_eq!(std::fs::read_dir(&victim).unwrap().count(), 0);
+        let file = dir.join("file");
+        std::fs::write(&file, "x").unwrap();
+        let err = prepare_private_root(&file).unwrap_err();
+        assert!(matches!(err, UnsafeDir::NotDir { .. }), "{err}");
+        let open = dir.join("open");
+        create_dir_all(&open).unwrap();
+        for bad in [0o777, 0o770] {
+            std::fs::set_permissions(&open, std::fs::Permissions::from_mode(bad)).unwrap();
+            let err = prepare_private_root(&open).unwrap_err();
+            assert!(
+                matches!(err, UnsafeDir::TooOpen { mode, .. } if mode == bad),
+                "{err}"
+            );
+            assert!(err.to_string().contains("rm -r"), "{err}");
+            assert!(check_private_root(&open, effective_uid()).is_err());
+        }
+    }
+
+    #[test]
+    fn a_root_below_a_parent_others_can_write_is_refused() {
+        let dir = scratch("rootparent");
+        let parent = dir.join("parent");
+        create_dir_all(&parent).unwrap();
+        std::fs::set_permissions(&parent, std::fs::Permissions::from_mode(0o777)).unwrap();
+        let err = prepare_private_root(&parent.join("iox")).unwrap_err();
+        assert!(matches!(err, UnsafeDir::WorldWritable { .. }), "{err}");
+        assert!(!parent.join("iox").exists());
+        std::fs::set_permissions(&parent, std::fs::Permissions::from_mode(0o1777)).unwrap();
+        prepare_private_root(&parent.join("iox")).unwrap();
+    }
+
+    #[test]
+    fn a_root_of_another_user_is_refused_with_the_fix() {
+        if effective_uid() != 0 {
+            assert!(
+                std::env::var("CI").as_deref() != Ok("true"),
+                "this test needs root to give a directory to another uid"
+            );
+            eprintln!("skipped: not root, cannot chown a directory to another uid");
+            return;
+        }
+        let dir = scratch("foreignroot");
+        let root = dir.join("iox");
+        std::fs::DirBuilder::new()
+            .mode(0o700)
+            .create(&root)
+            .unwrap();
+        std::os::unix::fs::chown(&root, Some(61032), Some(61032)).unwrap();
+        let err = prepare_private_root(&root).unwrap_err();
+        assert!(
+            matches!(err, UnsafeDir::ForeignRoot { owner: 61032, .. }),
+            "{err}"
+        );
+        assert!(err.to_string().contains("outputs.iceoryx2_root"), "{err}");
     }
 
     fn current_umask() -> u32 {

@@ -277,6 +277,10 @@ pub(super) fn event_line(event: &DaemonEvent) -> String {
              (outputs.cpu_wakeup_latency_us)"
         ),
         DaemonEvent::CpuLatencyRefused(error) => format!("bearingd: warning: {error}"),
+        DaemonEvent::IoxRootTightened { root, from } => format!(
+            "bearingd: iceoryx2 root {} was mode {from:04o}: now 0700 (only bearingd's user may use it)",
+            root.display()
+        ),
         DaemonEvent::AlertsOn { service, root } => format!(
             "bearingd: alerts on iceoryx2 service {service} (root {})",
             root.display()

@@ -136,12 +136,15 @@ impl Config {
     /// root of its own, so that a user without root can run it and `bearingd alerts
     /// --data-dir` finds the same root.
     ///
-    /// The root is `/dev/shm/bearingd-iox-<hash of the absolute data directory>` rather than
+    /// The root is private to the user (issue 32: a predictable root another user could
+    /// create first would let them read or forge alerts): `$XDG_RUNTIME_DIR/bearingd-iox-<hash
+    /// of the absolute data directory>` when that variable is set to an absolute path (a
+    /// login's own `0700` runtime directory), else `/run/bearingd/iox-<hash>` (the systemd
+    /// unit's `RuntimeDirectory=`; root creates it when missing). The daemon creates the root
+    /// `0700` and refuses one it does not own ([`crate::fsafe::prepare_private_root`]). Not
     /// inside the data directory: iceoryx2's socket paths below the root must fit in 108
-    /// bytes, which a deep working directory would exceed ([`MAX_IOX_ROOT_LEN`]). Not under
-    /// /tmp, which the config refuses (systemd's `PrivateTmp=` hides it from subscribers): the
-    /// default uses only what a config file may say. /dev/shm is writable by every user, is
-    /// where iceoryx2 keeps its shared memory anyway, and is the same for every process.
+    /// bytes, which a deep working directory would exceed ([`MAX_IOX_ROOT_LEN`]; a longer
+    /// `$XDG_RUNTIME_DIR` falls back to /run/bearingd).
     pub fn embedded_in(data_dir: &Path) -> Result<Config, String> {
         let mut config = Config::default_embedded().map_err(|e| e.to_string())?;
         let absolute = std::path::absolute(data_dir).map_err(|e| {
@@ -152,12 +155,21 @@ impl Config {
         })?;
         config.outputs.state_dir = data_dir.join("state");
         config.outputs.mcap_dir = data_dir.join("mcap");
-        config.outputs.iceoryx2_root = std::path::PathBuf::from(format!(
-            "/dev/shm/bearingd-iox-{:016x}",
-            fnv1a(absolute.as_os_str().as_encoded_bytes())
-        ));
+        let hash = fnv1a(absolute.as_os_str().as_encoded_bytes());
+        let runtime_dir = std::env::var_os("XDG_RUNTIME_DIR").map(std::path::PathBuf::from);
+        config.outputs.iceoryx2_root = default_iox_root(runtime_dir.as_deref(), hash);
         Ok(config)
     }
+}
+
+/// The embedded default's iceoryx2 root for the data directory's `hash`: under the user's
+/// runtime directory when it is absolute and short enough, else under /run/bearingd.
+fn default_iox_root(runtime_dir: Option<&Path>, hash: u64) -> std::path::PathBuf {
+    let per_user = runtime_dir
+        .filter(|dir| dir.is_absolute())
+        .map(|dir| dir.join(format!("bearingd-iox-{hash:016x}")))
+        .filter(|root| root.as_os_str().len() <= MAX_IOX_ROOT_LEN);
+    per_user.unwrap_or_else(|| std::path::PathBuf::from(format!("/run/bearingd/iox-{hash:016x}")))
 }
 
 /// FNV-1a, 64 bits: a short name that is the same for the same input in every run and every
@@ -166,4 +178,27 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325, |hash, &b| {
         (hash ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_default_iox_root_is_under_the_users_runtime_dir_or_run_bearingd() {
+        let root = default_iox_root(Some(Path::new("/run/user/1000")), 0xab);
+        assert_eq!(
+            root,
+            Path::new("/run/user/1000/bearingd-iox-00000000000000ab")
+        );
+        let fallback = Path::new("/run/bearingd/iox-00000000000000ab");
+        assert_eq!(default_iox_root(None, 0xab), fallback);
+        assert_eq!(
+            default_iox_root(Some(Path::new("relative")), 0xab),
+            fallback
+        );
+        let deep = Path::new("/run/user/1000/a/very/deep/runtime/directory/here");
+        assert_eq!(default_iox_root(Some(deep), 0xab), fallback);
+        assert!(fallback.as_os_str().len() <= MAX_IOX_ROOT_LEN);
+    }
 }

@@ -40,6 +40,9 @@ pub enum DaemonEvent {
     CpuLatencyCapped { latency_us: u32 },
     /// The cap of `outputs.cpu_wakeup_latency_us` could not be held; bearingd runs on without.
     CpuLatencyRefused(super::cpu_latency::CpuLatencyError),
+    /// The iceoryx2 root was this user's but readable by others (made by an earlier bearingd
+    /// or by iceoryx2, `0750`): it is now `0700`.
+    IoxRootTightened { root: PathBuf, from: u32 },
     /// The alert service is up.
     AlertsOn { service: String, root: PathBuf },
     /// A dead iceoryx2 node under the root (a killed daemon's, or a killed publisher's): its

@@ -1,8 +1,9 @@
 //! `bearingd run`: sources → the analysis thread → the sink thread, with the twin's re-fits on
 //! their own thread and status on the async side.
 //!
-//! [`run`] is a sequence of named steps: prepare the state directory, open the log, start the
-//! alert service, start the three threads, start the sources, supervise until a stop, stop in
+//! [`run`] is a sequence of named steps: prepare the state directory and the iceoryx2 root,
+//! lock the data directories, open the sources' devices, start the alert service and the fleet
+//! bridge, open the log (last, so that a refused start leaves no file), start the threads, start the sources, supervise until a stop, stop in
 //! order. Each thread owns its state and talks to the others over bounded channels only:
 //!
 //! - async (tokio): sources, signals, status. Sources send into the analysis queue
@@ -94,6 +95,8 @@ pub enum RunError {
     Locked(#[from] LockError),
     #[error("data directory refused: {0}")]
     UnsafeDir(#[from] crate::fsafe::UnsafeDir),
+    #[error("{0} (the default root is under $XDG_RUNTIME_DIR, else /run/bearingd; outputs.iceoryx2_root sets another)")]
+    IoxRoot(crate::fsafe::UnsafeDir),
     #[error("MCAP log: {0}")]
     Log(#[from] McapLogError),
     #[cfg(feature = "shm")]
@@ -145,11 +148,14 @@ pub async fn run(
     events: Events,
     shutdown: impl std::future::Future<Output = ()>,
 ) -> Result<RunSummary, RunError> {
+    // Everything that can refuse the start comes before the log, which is opened last: a
+    // refused start must not leave an empty log behind (one per restart, issue 32).
     let state_dir = prepare_state_dir(&config)?;
+    prepare_iox_root(&config, &events)?;
     let _locks = lock_data_dirs(&config, &events)?;
-    // The sources' devices before the log: a missing CAN interface must stop the start
-    // before a file exists (it left an empty log behind on every restart).
     let can_sources = open_can_sources(&config)?;
+    let learned = load_learned(&config.twin)?;
+    let alerts = start_alerts(&config, &events)?;
     // Wall time of sample 0: the log's time base, and the fleet bridge's.
     let origin_ns = wall_clock_now_ns();
     // The learned state before the log, which records what the run started with.
@@ -159,13 +165,10 @@ pub async fn run(
         Ok(None) => events(DaemonEvent::NoState(state_dir.clone())),
         Err(problem) => events(DaemonEvent::State(problem)),
     }
+    let fleet = start_fleet(&config, origin_ns, &events)?;
     sinks.push(Box::new(open_log(&config, origin_ns, &baselines, &events)?));
-    if let Some(fleet) = start_fleet(&config, origin_ns, &events)? {
-        sinks.push(Box::new(fleet));
-    }
-    let alerts = start_alerts(&config, &events)?;
+    sinks.extend(fleet.map(|fleet| Box::new(fleet) as Box<dyn Sink>));
     let _cpu_latency = cap_cpu_latency(&config, &events);
-    let learned = load_learned(&config.twin)?;
     let pipeline = Pipeline::new(
         &config,
         &baselines,
@@ -280,6 +283,23 @@ fn prepare_data_dir(dir: &Path) -> Result<(), RunError> {
         source,
     })?;
     crate::fsafe::check_private_dir(dir)?;
+    Ok(())
+}
+
+/// Makes `outputs.iceoryx2_root` this user's private directory ([`crate::fsafe::prepare_private_root`])
+/// before iceoryx2, which would follow a link there and create it `0750`, touches it.
+fn prepare_iox_root(config: &Config, events: &Events) -> Result<(), RunError> {
+    if !cfg!(feature = "shm") {
+        return Ok(()); // no iceoryx2 in this build: the root is never used
+    }
+    let root = &config.outputs.iceoryx2_root;
+    match crate::fsafe::prepare_private_root(root).map_err(RunError::IoxRoot)? {
+        crate::fsafe::RootPrepared::Tightened { from } => events(DaemonEvent::IoxRootTightened {
+            root: root.clone(),
+            from,
+        }),
+        crate::fsafe::RootPrepared::Created | crate::fsafe::RootPrepared::Ready => {}
+    }
     Ok(())
 }
 

@@ -34,7 +34,7 @@ fn mode_of(path: &Path) -> u32 {
 }
 
 /// The default config with an iceoryx2 root of the test's own, in `dir/config.toml`.
-fn config(dir: &Path, tag: &str) -> PathBuf {
+pub(super) fn config(dir: &Path, tag: &str) -> PathBuf {
     let out = bearingd(&["config", "default"]);
     assert!(out.status.success(), "{}", stderr_of(&out));
     let root = iox_root(env!("CARGO_TARGET_TMPDIR"), tag);
@@ -50,7 +50,7 @@ fn config(dir: &Path, tag: &str) -> PathBuf {
 
 /// `bearingd run` of `config` on `data`, 2 s of simulated signal as fast as it goes, under
 /// `umask` (the shell sets it, then execs the binary).
-fn run_daemon(config: &Path, data: &Path, umask: &str) -> Output {
+pub(super) fn run_daemon(config: &Path, data: &Path, umask: &str) -> Output {
     Command::new("sh")
         .arg("-c")
         .arg(format!("umask {umask}; exec \"$0\" \"$@\""))

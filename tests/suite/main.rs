@@ -12,6 +12,7 @@ mod envelope;
 mod evaluate_recordings;
 mod fleet;
 mod formats;
+mod hostile_alerts;
 mod hostile_files;
 mod hostile_logs;
 mod kinematics;

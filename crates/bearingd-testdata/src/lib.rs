@@ -64,11 +64,16 @@ pub fn scratch_dir(test: &str) -> PathBuf {
 }
 
 /// An iceoryx2 root for a test, unique per process and `tag`: below `target_tmp` (pass
-/// `env!("CARGO_TARGET_TMPDIR")`), or in `/dev/shm/bearingd-tests` when the checkout itself
-/// is under /tmp or /var/tmp, or so deep that the root would be too long. (why) The config
-/// refuses a root under /tmp (systemd's PrivateTmp= would hide it from subscribers) and one
-/// longer than 56 bytes (iceoryx2's Unix socket paths below it must fit in 108), and CI must
-/// pass from a clone in any directory. Keep `tag` short.
+/// `env!("CARGO_TARGET_TMPDIR")`), or in `/dev/shm/bearingd-tests-<uid>` (this user's, made
+/// `0700` here) when the checkout itself is under /tmp or /var/tmp, or so deep that the root
+/// would be too long. (why) The config refuses a root under /tmp (systemd's PrivateTmp= would
+/// hide it from subscribers) and one longer than 56 bytes (iceoryx2's Unix socket paths below
+/// it must fit in 108), and CI must pass from a clone in any directory. The daemon refuses a
+/// root another user owns or could write in, so the shared fallback is per user and private.
+/// Keep `tag` short.
+///
+/// # Panics
+/// When the fallback directory cannot be made this user's private directory (tests only).
 pub fn iox_root(target_tmp: &str, tag: &str) -> PathBuf {
     let name = format!("{tag}-{}", std::process::id());
     let below_target = Path::new(target_tmp).join(&name);
@@ -76,10 +81,35 @@ pub fn iox_root(target_tmp: &str, tag: &str) -> PathBuf {
         .iter()
         .any(|t| below_target.starts_with(t));
     if under_tmp || below_target.as_os_str().len() > 50 {
-        Path::new("/dev/shm/bearingd-tests").join(name)
+        private_shm_dir().join(name)
     } else {
         below_target
     }
+}
+
+/// `/dev/shm/bearingd-tests-<effective uid>`, created `0700`; an existing one must be a
+/// directory of this user (not a link), and is set to `0700`.
+fn private_shm_dir() -> PathBuf {
+    use std::os::unix::fs::{DirBuilderExt, MetadataExt, PermissionsExt};
+    let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    let uid: u32 = status
+        .lines()
+        .find_map(|l| l.strip_prefix("Uid:"))
+        .and_then(|ids| ids.split_whitespace().nth(1))
+        .and_then(|euid| euid.parse().ok())
+        .unwrap_or_else(|| panic!("cannot read the effective uid from /proc/self/status"));
+    let dir = PathBuf::from(format!("/dev/shm/bearingd-tests-{uid}"));
+    let _ = std::fs::DirBuilder::new().mode(0o700).create(&dir);
+    let meta = std::fs::symlink_metadata(&dir)
+        .unwrap_or_else(|e| panic!("cannot create {}: {e}", dir.display()));
+    assert!(
+        meta.is_dir() && meta.uid() == uid,
+        "{} is not a directory of uid {uid} (a link, a file or another user's): remove it",
+        dir.display()
+    );
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700))
+        .unwrap_or_else(|e| panic!("cannot chmod 0700 {}: {e}", dir.display()));
+    dir
 }
 
 /// The `.mcap` files directly in `dir`, sorted by name (empty if it cannot be read).
