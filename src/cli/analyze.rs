@@ -45,7 +45,8 @@ pub struct AnalyzeArgs {
     /// records, the record's file name is added before the extension.
     #[arg(long)]
     plot: Option<PathBuf>,
-    /// Take the analysis settings from this configuration file's [analysis] section.
+    /// Take the analysis settings from this configuration file's [analysis] section, and its
+    /// twin.learned_model unless --learned is given: the daemon's decision, offline.
     #[arg(long)]
     config: Option<PathBuf>,
     /// How to choose the resonance band.
@@ -127,13 +128,21 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
     if args.hw {
         return super::hw_table::run(&args.files, &args.recording, args.hw_states.into());
     }
-    let settings = settings_from(args)?;
+    let config = match &args.config {
+        Some(path) => Some(crate::config::load(path).map_err(CliError::input)?),
+        None => None,
+    };
+    let settings = settings_from(args, config.as_ref())?;
     let files: Vec<Option<PathBuf>> = if args.demo {
         vec![None]
     } else {
         args.files.iter().cloned().map(Some).collect()
     };
-    let learned = match &args.learned {
+    let learned_path = args
+        .learned
+        .as_ref()
+        .or(config.as_ref().and_then(|c| c.twin.learned_model.as_ref()));
+    let learned = match learned_path {
         Some(path) => Some(std::sync::Arc::new(
             crate::learned::LearnedModel::load(path).map_err(CliError::input)?,
         )),
@@ -242,11 +251,11 @@ fn per_record_path(plot: &Path, record: &str) -> PathBuf {
     plot.with_file_name(format!("{stem}-{record}.{ext}"))
 }
 
-fn settings_from(args: &AnalyzeArgs) -> Result<AnalysisSettings, CliError> {
-    let mut settings = match &args.config {
-        Some(path) => crate::config::load(path).map_err(CliError::input)?.analysis,
-        None => AnalysisSettings::default(),
-    };
+fn settings_from(
+    args: &AnalyzeArgs,
+    config: Option<&crate::config::Config>,
+) -> Result<AnalysisSettings, CliError> {
+    let mut settings = config.map_or_else(AnalysisSettings::default, |c| c.analysis.clone());
     if let Some(window) = args.window {
         if !(window.is_finite() && window > 0.01 && window <= 10.0) {
             return Err(CliError::input(format!(

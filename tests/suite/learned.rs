@@ -241,3 +241,46 @@ fn a_config_whose_learned_model_does_not_fit_its_sensors_lists_the_problem() {
         "{err}"
     );
 }
+
+/// `analyze --config C` decides as the daemon configured by C does: it hears C's
+/// `twin.learned_model` (before, only `--learned` did, so C's agreement went unheard offline).
+#[test]
+fn analyze_with_a_config_hears_its_learned_model() {
+    let dir = scratch_dir("learned-analyze-config");
+    let model = repo_root().join("models/skf-6205-2rs.safetensors");
+    let sensor = "[[sensors]]\nid = \"s\"\ntransport = \"sim\"\nsample_rate_hz = 12000\nbearing = \"skf-6205-2rs\"\n[sensors.speed]\nsource = \"fixed\"\nrpm = 1772\n";
+    let with_model = dir.join("with-model.toml");
+    std::fs::write(
+        &with_model,
+        format!("{sensor}[twin]\nlearned_model = \"{}\"\n", model.display()),
+    )
+    .unwrap();
+    let without = dir.join("without.toml");
+    std::fs::write(&without, sensor).unwrap();
+    let json_of = |config: &std::path::Path| {
+        let out = bearingd(&[
+            "analyze",
+            "--demo",
+            "--format",
+            "json",
+            "--config",
+            config.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let heard = json_of(&with_model);
+    let opinion = &heard["learned"]["opinion"];
+    assert!(
+        opinion["model"]
+            .as_str()
+            .is_some_and(|m| m.ends_with("skf-6205-2rs.safetensors"))
+            && opinion["segments"].as_u64().is_some_and(|n| n > 0),
+        "{heard}"
+    );
+    let unheard = json_of(&without);
+    assert!(
+        unheard.get("learned").is_none_or(|l| l.is_null()),
+        "{unheard}"
+    );
+}
