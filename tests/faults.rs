@@ -726,8 +726,9 @@ fn issue11_a_full_disk_pauses_the_log_keeps_analysing_and_resumes_when_there_is_
 }
 
 /// The flag change printed while logging was paused (`FLAG …` line) is in `/flags/…` (or
-/// `/velocity_flags/…`) exactly once, as Python's strict reader sees it: marked `"late": true`, published when it was
-/// decided and logged at the resume (later); the journal said it was written late.
+/// `/velocity_flags/…`) exactly once, as Python's strict reader sees it: marked `"late": true`,
+/// published when it was decided and logged at the resume (later); the journal said it was
+/// written late.
 fn assert_flag_logged_late(py: &Path, files: &[PathBuf], flag: &str, journal: &[String]) {
     let sample: u64 = flag
         .rsplit("at sample ")
@@ -752,18 +753,23 @@ fn assert_flag_logged_late(py: &Path, files: &[PathBuf], flag: &str, journal: &[
     assert_eq!(late["json"]["late"], serde_json::json!(true), "{late}");
     let (published, log_time) = (late["publish_time"].as_u64(), late["log_time"].as_u64());
     assert!(published < log_time, "{late}");
+    let (published, log_time) = (published.unwrap_or(0), log_time.unwrap_or(0));
+    eprintln!(
+        "the flag of the pause: logged once, late by {:.1} s (log_time - publish_time)",
+        (log_time - published) as f64 / 1e9
+    );
     // "bearingd: written late to FILE (…): flag changes K, health events H decided during the
     // pause"
-    let flags_late: u64 = journal
+    let said = journal
         .iter()
-        .find_map(|l| {
-            l.split_once("written late to")?
-                .1
-                .split_once("flag changes ")
-        })
-        .and_then(|(_, rest)| rest.split(',').next()?.parse().ok())
+        .find(|l| l.contains("written late to"))
         .unwrap_or_else(|| panic!("no line on what was written late: {journal:#?}"));
-    assert!(flags_late >= 1, "{journal:#?}");
+    let flags_late: u64 = said
+        .split_once("flag changes ")
+        .and_then(|(_, rest)| rest.split(',').next()?.parse().ok())
+        .unwrap_or_else(|| panic!("{said}"));
+    eprintln!("{said}");
+    assert!(flags_late >= 1, "{said}");
 }
 
 /// A log written with another config (another sample rate, another run) in the data
