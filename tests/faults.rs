@@ -6,7 +6,9 @@
 
 use bearingd::mcap_log::read_messages;
 use bearingd::messages::PipelineMessage;
-use bearingd_testdata::{check_mcap_with_python, mcap_files, noise, python_mcap, scratch_dir};
+use bearingd_testdata::{
+    check_mcap_with_python, log_topics_with_python, mcap_files, noise, python_mcap, scratch_dir,
+};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -692,6 +694,7 @@ fn issue11_a_full_disk_pauses_the_log_keeps_analysing_and_resumes_when_there_is_
         for file in &files {
             check_mcap_with_python(&py, file, None);
         }
+        assert_flag_logged_late(&py, &files, &flag, &all_err);
     }
     // The signal lost: the holes between raw blocks in the files.
     let (ranges, rate) = raw_ranges(&files);
@@ -720,6 +723,53 @@ fn issue11_a_full_disk_pauses_the_log_keeps_analysing_and_resumes_when_there_is_
         (lost_s - said_lost).abs() <= 1.5,
         "measured {lost_s:.2} s, said {said_lost:.1} s"
     );
+}
+
+/// The flag change printed while logging was paused (`FLAG …` line) is in `/flags/…` (or
+/// `/velocity_flags/…`) exactly once, as Python's strict reader sees it: marked `"late": true`,
+/// published when it was decided and logged at the resume (later); the journal said it was
+/// written late.
+fn assert_flag_logged_late(py: &Path, files: &[PathBuf], flag: &str, journal: &[String]) {
+    let sample: u64 = flag
+        .rsplit("at sample ")
+        .next()
+        .and_then(|n| n.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{flag}"));
+    let topic = if flag.contains(": iso_zone ") {
+        "/velocity_flags/"
+    } else {
+        "/flags/"
+    };
+    let logged: Vec<serde_json::Value> = files
+        .iter()
+        .flat_map(|file| log_topics_with_python(py, file))
+        .filter(|m| {
+            m["topic"].as_str().is_some_and(|t| t.starts_with(topic))
+                && m["json"]["end_sample"].as_u64() == Some(sample)
+        })
+        .collect();
+    assert_eq!(logged.len(), 1, "{flag}: {logged:#?}");
+    let late = &logged[0];
+    assert_eq!(late["json"]["late"], serde_json::json!(true), "{late}");
+    let (published, log_time) = (late["publish_time"].as_u64(), late["log_time"].as_u64());
+    assert!(published < log_time, "{late}");
+    let (published, log_time) = (published.unwrap_or(0), log_time.unwrap_or(0));
+    eprintln!(
+        "the flag of the pause: logged once, late by {:.1} s (log_time - publish_time)",
+        (log_time - published) as f64 / 1e9
+    );
+    // "bearingd: written late to FILE (…): flag changes K, health events H decided during the
+    // pause"
+    let said = journal
+        .iter()
+        .find(|l| l.contains("written late to"))
+        .unwrap_or_else(|| panic!("no line on what was written late: {journal:#?}"));
+    let flags_late: u64 = said
+        .split_once("flag changes ")
+        .and_then(|(_, rest)| rest.split(',').next()?.parse().ok())
+        .unwrap_or_else(|| panic!("{said}"));
+    eprintln!("{said}");
+    assert!(flags_late >= 1, "{said}");
 }
 
 /// A log written with another config (another sample rate, another run) in the data

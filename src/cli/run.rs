@@ -9,7 +9,7 @@ use crate::mcap_log::files::utc_text;
 use crate::messages::{FlagMessage, HealthKind, PipelineMessage, SpeedSource};
 use crate::pipeline::{ChannelStatus, Sink, SinkError};
 use crate::report::plain::flag_words;
-use crate::sinks::mcap::{LogNotice, RecoveryAction, RecoveryReport, RetentionReport};
+use crate::sinks::mcap::{LateCounts, LogNotice, RecoveryAction, RecoveryReport, RetentionReport};
 use clap::Args;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -254,12 +254,40 @@ fn log_notice_line(notice: &LogNotice) -> String {
             "bearingd: logging resumed in {}: {messages_not_logged} messages not logged during the pause, {seconds_not_logged:.1} s of signal lost",
             path.display()
         ),
+        LogNotice::LateWritten {
+            path,
+            written,
+            dropped,
+        } => format!(
+            "bearingd: written late to {} (\"late\": true, publish_time = when decided): flag changes {}, health events {} decided during the pause{}",
+            path.display(),
+            written.flags,
+            written.health,
+            dropped_line(dropped)
+        ),
+        LogNotice::LateLost { held, dropped } => format!(
+            "bearingd: warning: stopped while logging was paused: flag changes {}, health events {} held for the log were never written (the FLAG lines above have the flag changes){}",
+            held.flags,
+            held.health,
+            dropped_line(dropped)
+        ),
         LogNotice::PausedFileRecovered(report) => recovery_line(report),
         LogNotice::PausedFileNotRecovered { path, error } => format!(
             "bearingd: warning: {} (left by the pause) could not be recovered now: {error}; the next start recovers it",
             path.display()
         ),
     }
+}
+
+/// What a pause could not hold in memory, said after what it held.
+fn dropped_line(dropped: &LateCounts) -> String {
+    if dropped.total() == 0 {
+        return String::new();
+    }
+    format!(
+        "; {} flag changes and {} health events dropped for lack of room in memory (the /state snapshot at the resume has the latest)",
+        dropped.flags, dropped.health
+    )
 }
 
 /// How an event other than a status reads on stderr.

@@ -216,9 +216,30 @@ impl JsonKind {
             JsonKind::VelocityFlag => generator.into_root_schema_for::<VelocityFlagMessage>(),
         };
         schema.insert("title".into(), self.schema_name().into());
-        schema.to_value()
+        let mut value = schema.to_value();
+        if self.can_be_late() {
+            if let Some(properties) = value.get_mut("properties").and_then(Value::as_object_mut) {
+                properties.insert(
+                    "late".into(),
+                    json!({"type": "boolean", "description": LATE_DESCRIPTION}),
+                );
+            }
+        }
+        value
+    }
+
+    /// The kinds held back while the log is paused and written late ([`encode_late`]).
+    pub fn can_be_late(self) -> bool {
+        matches!(
+            self,
+            JsonKind::Flag | JsonKind::Health | JsonKind::VelocityFlag
+        )
     }
 }
+
+const LATE_DESCRIPTION: &str = "Present (true) only when the message was decided while the log \
+    was paused (a full disk) and written when it resumed: publish_time is when it was decided, \
+    log_time the resume";
 
 /// The topic of the daemon's notes about its own logs (retention, a pause for a full disk).
 pub const LOG_TOPIC: &str = "/log";
@@ -392,6 +413,44 @@ pub fn encode(
     };
     debug_assert!(r.is_ok());
     Some(kind)
+}
+
+/// A message with `"late": true` after its own fields.
+#[derive(serde::Serialize)]
+struct LateMessage<'a, T> {
+    #[serde(flatten)]
+    message: &'a T,
+    late: bool,
+}
+
+/// [`encode`] for a message written late, after a pause of the log: flag changes and health
+/// events ([`JsonKind::can_be_late`]) carry `"late": true`; other kinds are encoded as by
+/// [`encode`].
+pub fn encode_late(
+    message: &PipelineMessage,
+    topic: &mut String,
+    payload: &mut Vec<u8>,
+) -> Option<JsonKind> {
+    let kind = encode(message, topic, payload);
+    let marked = match message {
+        PipelineMessage::Flag(m) => mark_late(m, payload),
+        PipelineMessage::Health(m) => mark_late(m, payload),
+        PipelineMessage::VelocityFlag(m) => mark_late(m, payload),
+        _ => Ok(()),
+    };
+    debug_assert!(marked.is_ok());
+    kind
+}
+
+fn mark_late<T: serde::Serialize>(message: &T, payload: &mut Vec<u8>) -> serde_json::Result<()> {
+    payload.clear();
+    serde_json::to_writer(
+        payload,
+        &LateMessage {
+            message,
+            late: true,
+        },
+    )
 }
 
 #[cfg(test)]
@@ -679,6 +738,47 @@ mod tests {
             assert!(!schema.to_string().contains("$ref"), "inlined: {schema}");
             check(&schema, &value, kind.schema_name()).unwrap_or_else(|e| panic!("{e}\n{schema}"));
         }
+    }
+
+    #[test]
+    fn a_message_written_late_says_so_fits_its_schema_and_reads_back_the_same() {
+        let mut marked = 0;
+        for message in samples() {
+            let (mut topic, mut payload) = (String::new(), Vec::new());
+            let kind = encode_late(&message, &mut topic, &mut payload).expect("a JSON kind");
+            let value: Value = serde_json::from_slice(&payload).expect("JSON");
+            check(&kind.json_schema(), &value, kind.schema_name())
+                .unwrap_or_else(|e| panic!("{e}"));
+            let (mut on_time_topic, mut on_time) = (String::new(), Vec::new());
+            encode(&message, &mut on_time_topic, &mut on_time);
+            assert_eq!(topic, on_time_topic);
+            if !kind.can_be_late() {
+                assert_eq!(
+                    payload, on_time,
+                    "{topic}: only flags and health are marked"
+                );
+                continue;
+            }
+            marked += 1;
+            assert_eq!(value["late"], Value::Bool(true), "{topic}");
+            // Readers that do not know the field decode the same message.
+            let read_back = match &message {
+                PipelineMessage::Flag(_) => {
+                    PipelineMessage::Flag(serde_json::from_slice(&payload).expect("a flag"))
+                }
+                PipelineMessage::Health(_) => {
+                    PipelineMessage::Health(serde_json::from_slice(&payload).expect("health"))
+                }
+                _ => PipelineMessage::VelocityFlag(
+                    serde_json::from_slice(&payload).expect("a velocity flag"),
+                ),
+            };
+            assert_eq!(read_back, message);
+        }
+        assert_eq!(
+            marked, 4,
+            "the samples: a flag, two health events, a velocity flag"
+        );
     }
 
     #[test]

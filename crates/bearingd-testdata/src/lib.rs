@@ -247,6 +247,29 @@ pub fn check_mcap_with_python(
     serde_json::from_slice(&out.stdout).expect("summary JSON")
 }
 
+/// Runs `tests/python/log_topics.py` on `file`: its messages in log-time order as Python's
+/// strict reader sees them (`topic`, `log_time`, `publish_time`, and `json` for the low-rate
+/// JSON topics).
+///
+/// # Panics
+/// When the file does not read strictly (tests only).
+pub fn log_topics_with_python(py: &Path, file: &Path) -> Vec<serde_json::Value> {
+    let script = repo_root().join("tests/python/log_topics.py");
+    let out = std::process::Command::new(py)
+        .arg(script)
+        .arg(file)
+        .output()
+        .expect("run log_topics.py");
+    assert!(
+        out.status.success(),
+        "log_topics.py failed on {}:\n{}",
+        file.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    summary["messages"].as_array().cloned().unwrap_or_default()
+}
+
 /// A deterministic pseudo-random byte stream (xorshift), for files that are not logs.
 pub fn noise(len: usize, mut seed: u64) -> Vec<u8> {
     (0..len)

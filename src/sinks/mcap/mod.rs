@@ -5,16 +5,20 @@
 //! loses), recovers unfinished files at start, and finishes the file at shutdown. It also
 //! begins every file opened by rotation with the current state (`/state`), writes a `/log`
 //! note for each retention deletion, and pauses logging when a write fails (a full disk)
-//! without stopping the pipeline, resuming when the directory has room ([`LogNotice`]). The
+//! without stopping the pipeline, resuming when the directory has room ([`LogNotice`]); the
+//! flag changes and health events of the pause are held ([`late`]) and written first then,
+//! marked late. The
 //! format itself (schemas, topics, file names, reading back) is [`crate::mcap_log`]; what each
 //! file says about itself in MCAP metadata records is [`metadata`]; a recording written as
 //! such a log (`import`, `dataset`, `evaluate --recordings`) is [`raw_log`].
 
+pub mod late;
 pub mod metadata;
 pub mod raw_log;
 pub mod recover;
 pub mod writer;
 
+pub use late::{LateBacklog, LateCounts};
 pub use recover::{
     is_finished, recover_directory, recover_file, RecoveryAction, RecoveryReport, QUARANTINE_DIR,
 };
@@ -57,6 +61,20 @@ pub enum LogNotice {
         /// Log time from the last flush before the pause to the first message logged after it.
         seconds_not_logged: f64,
     },
+    /// The flag changes and health events decided during the pause (and those logged since the
+    /// last flush before it, lost with the unwritten chunk) were written in `path` at the
+    /// resume, marked late; `dropped` did not fit in memory.
+    LateWritten {
+        path: PathBuf,
+        written: LateCounts,
+        dropped: LateCounts,
+    },
+    /// The daemon stopped while logging was still paused: what was held for the log was
+    /// never written.
+    LateLost {
+        held: LateCounts,
+        dropped: LateCounts,
+    },
     /// A file left by a pause was recovered (or could not be, and waits for the next start).
     PausedFileRecovered(RecoveryReport),
     PausedFileNotRecovered {
@@ -73,6 +91,8 @@ struct Pause {
     next_try_ns: u64,
     /// Files left unfinished by the failure, to recover when there is room.
     abandoned: Vec<PathBuf>,
+    /// Flag changes and health events to write first when logging resumes.
+    late: LateBacklog,
 }
 
 /// The current state per channel (last flag change per fault, last health per kind, last
@@ -131,6 +151,9 @@ pub struct McapSink {
     errors: Vec<McapLogError>,
     pub messages: u64,
     state: CurrentState,
+    /// Flag changes and health events logged since the last flush that reached the file: a
+    /// failure loses them with the open chunk, so a pause holds them to write late.
+    since_flush: LateBacklog,
     pause: Option<Pause>,
     /// Told of retention, pauses and resumptions (the operator must know).
     on_notice: Box<dyn Fn(&LogNotice) + Send>,
@@ -164,6 +187,7 @@ impl McapSink {
                 errors: Vec::new(),
                 messages: 0,
                 state: CurrentState::default(),
+                since_flush: LateBacklog::default(),
                 pause: None,
                 on_notice: Box::new(|_| {}),
             },
@@ -274,6 +298,8 @@ impl McapSink {
             return Ok(());
         };
         let report = logger.rotate(at_ns)?;
+        // The previous file was finished: what was logged in it is on the disk.
+        self.since_flush.clear();
         logger.write_state(&self.state.snapshot(), at_ns)?;
         self.retention_done(report, at_ns);
         Ok(())
@@ -283,13 +309,17 @@ impl McapSink {
     /// pauses until there is room again; the pipeline goes on.
     fn pause(&mut self, error: &McapLogError, at_ns: u64) {
         let abandoned = self.logger.as_mut().and_then(McapLogger::abandon);
-        let pause = self.pause.get_or_insert(Pause {
+        let pause = self.pause.get_or_insert_with(|| Pause {
             flushed_until_ns: self.flushed_ns,
             messages: 0,
             next_try_ns: at_ns,
             abandoned: Vec::new(),
+            late: LateBacklog::default(),
         });
         pause.next_try_ns = at_ns + RETRY_EVERY_NS;
+        // What was logged since the last flush went with the open chunk: it comes first.
+        let held = std::mem::replace(&mut pause.late, std::mem::take(&mut self.since_flush));
+        pause.late.append(held);
         if let Some(path) = abandoned {
             pause.abandoned.push(path.clone());
             (self.on_notice)(&LogNotice::Paused {
@@ -318,9 +348,11 @@ impl McapSink {
             return false;
         }
         let notices = recover_abandoned(std::mem::take(&mut pause.abandoned));
+        let mut retention = Vec::new();
         let opened = logger
             .reopen(at_ns)
             .and_then(|()| logger.write_state(&self.state.snapshot(), at_ns))
+            .and_then(|()| write_late(logger, &pause.late, at_ns, &mut retention))
             .and_then(|()| logger.flush());
         for notice in &notices {
             (self.on_notice)(notice);
@@ -335,6 +367,7 @@ impl McapSink {
         }
         let seconds = at_ns.saturating_sub(pause.flushed_until_ns) as f64 / 1e9;
         let messages = pause.messages;
+        let late = std::mem::take(&mut pause.late);
         let text = format!(
             "logging resumed after a write failure (full disk?): {messages} messages of the \
              pipeline were not logged, {seconds:.1} s of signal from the last flush before the \
@@ -351,13 +384,50 @@ impl McapSink {
             return false;
         }
         self.flushed_ns = at_ns;
+        self.messages += late.held().total();
         (self.on_notice)(&LogNotice::Resumed {
-            path,
+            path: path.clone(),
             messages_not_logged: messages,
             seconds_not_logged: seconds,
         });
+        if !late.is_empty() {
+            (self.on_notice)(&LogNotice::LateWritten {
+                path,
+                written: late.held(),
+                dropped: late.dropped(),
+            });
+        }
+        for report in retention {
+            self.retention_done(report, at_ns);
+        }
         true
     }
+}
+
+/// Writes what a pause held, at `at_ns` (the resume) after a `/log` note saying what follows:
+/// each message as decided (its time as `publish_time`), marked late. A rotation on the way
+/// (not expected: the file was just opened) leaves its retention report in `retention`.
+fn write_late(
+    logger: &mut McapLogger,
+    late: &LateBacklog,
+    at_ns: u64,
+    retention: &mut Vec<RetentionReport>,
+) -> Result<(), McapLogError> {
+    if late.is_empty() {
+        return Ok(());
+    }
+    let (held, dropped) = (late.held(), late.dropped());
+    let text = format!(
+        "{} flag changes and {} health events decided during the pause follow, written late \
+         (\"late\": true; publish_time = when decided, log_time = now); {} flag changes and {} \
+         health events dropped for lack of room in memory (the /state snapshot has the latest)",
+        held.flags, held.health, dropped.flags, dropped.health
+    );
+    logger.note(LogLevel::Warning, &text, at_ns)?;
+    for message in late.iter() {
+        retention.extend(logger.log_late(&message.message, at_ns, message.decided_ns)?);
+    }
+    Ok(())
 }
 
 /// An error's message followed by those of its causes that it does not already say (the
@@ -417,12 +487,20 @@ impl Sink for McapSink {
         let resumed = self.pause.is_none() || self.try_resume(self.last_ns);
         if resumed {
             self.log(message, time);
+        } else if let Some(pause) = self.pause.as_mut() {
+            pause.late.push(message, time);
         }
         self.state.note(message);
     }
 
     fn finish(&mut self) -> Result<(), SinkError> {
         if let Some(pause) = self.pause.take() {
+            if !pause.late.is_empty() {
+                (self.on_notice)(&LogNotice::LateLost {
+                    held: pause.late.held(),
+                    dropped: pause.late.dropped(),
+                });
+            }
             for notice in recover_abandoned(pause.abandoned) {
                 (self.on_notice)(&notice);
             }
@@ -469,6 +547,7 @@ impl McapSink {
         match logger.log(message, log_time, time) {
             Ok(rotated) => {
                 self.messages += 1;
+                self.since_flush.push(message, time);
                 if let Some(report) = rotated {
                     self.retention_done(report, log_time);
                 }
@@ -491,7 +570,10 @@ impl McapSink {
                 logger.flush()
             };
             match done {
-                Ok(()) => self.flushed_ns = self.last_ns,
+                Ok(()) => {
+                    self.flushed_ns = self.last_ns;
+                    self.since_flush.clear();
+                }
                 Err(e) => self.pause(&e, time),
             }
         }

@@ -567,6 +567,28 @@ impl McapLogger {
         log_time_ns: u64,
         publish_time_ns: u64,
     ) -> Result<Option<RetentionReport>> {
+        self.log_encoded(message, log_time_ns, publish_time_ns, encode)
+    }
+
+    /// [`log`](Self::log) for a flag change or health event decided while logging was paused
+    /// and written when it resumed: `log_time_ns` is the resume, `publish_time_ns` the
+    /// decision, and the message carries `"late": true` ([`schema::encode_late`]).
+    pub fn log_late(
+        &mut self,
+        message: &PipelineMessage,
+        log_time_ns: u64,
+        decided_ns: u64,
+    ) -> Result<Option<RetentionReport>> {
+        self.log_encoded(message, log_time_ns, decided_ns, schema::encode_late)
+    }
+
+    fn log_encoded(
+        &mut self,
+        message: &PipelineMessage,
+        log_time_ns: u64,
+        publish_time_ns: u64,
+        encoder: fn(&PipelineMessage, &mut String, &mut Vec<u8>) -> Option<JsonKind>,
+    ) -> Result<Option<RetentionReport>> {
         let rotation = match &self.open {
             Some(f) => {
                 let too_big = f.bytes() >= self.config.max_file_bytes;
@@ -586,7 +608,7 @@ impl McapLogger {
         };
 
         self.topic.clear();
-        let kind = encode(message, &mut self.topic, &mut self.payload);
+        let kind = encoder(message, &mut self.topic, &mut self.payload);
         let Some(file) = self.open.as_mut() else {
             return Err(McapLogError::Config("no open file".into()));
         };
