@@ -376,3 +376,43 @@ fn roots_subscribers_refuse_another_users_root_and_never_switch_to_it() {
     }
     std::fs::remove_dir_all(&shared).unwrap();
 }
+
+/// Guard (worked before issue 32 and must still work): the daemon killed (`kill -9`) and
+/// restarted while `bearingd alerts` stays connected. The connected subscriber keeps the
+/// service alive, so the new daemon removes the dead node, reopens its own previous service
+/// (same user, same shape) and says so; the subscriber's checks accept the new publisher.
+#[test]
+fn a_daemon_killed_and_restarted_under_a_connected_subscriber_reopens_its_service() {
+    let dir = scratch_dir("hostile-restart");
+    let config = config(&dir, "hre");
+    let root = iox_root(env!("CARGO_TARGET_TMPDIR"), "hre");
+    let data = dir.join("data");
+    let mut first = live_daemon(&config, &data, &root, "60");
+    let subscriber = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(["alerts", "--json", "--timeout", "10", "--config"])
+        .arg(&config)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_secs(2));
+    first.kill().unwrap();
+    first.wait().unwrap();
+    let second = live_daemon(&config, &data, &root, "60");
+    std::thread::sleep(Duration::from_secs(3));
+    let out = stop(second);
+    let err = stderr_of(&out);
+    let seen = subscriber.wait_with_output().unwrap();
+    let seen_err = stderr_of(&seen);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("reopened our previous run's service"), "{err}");
+    assert!(
+        err.contains("removed the stale resources of a dead"),
+        "{err}"
+    );
+    assert!(
+        !seen_err.contains("not to be trusted"),
+        "the subscriber refused the restarted daemon: {seen_err}"
+    );
+    assert_eq!(seen.status.code(), Some(0), "{seen_err}");
+}
