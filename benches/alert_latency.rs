@@ -134,7 +134,7 @@ fn main() {
         };
         let started = Instant::now();
         let mut subscriber = loop {
-            match AlertSubscriber::open(&settings) {
+            match AlertSubscriber::open(&settings, bearingd::fsafe::effective_uid()) {
                 Ok(s) => break s,
                 Err(e) if started.elapsed() > Duration::from_secs(30) => {
                     panic!("the daemon's alert service never appeared: {e}")
@@ -142,16 +142,24 @@ fn main() {
                 Err(_) => std::thread::sleep(Duration::from_millis(50)),
             }
         };
-        subscriber.take_history(Duration::from_millis(200));
+        subscriber
+            .take_history(Duration::from_millis(200))
+            .expect("the daemon's alert service passes the owner checks");
         let mut round_alerts = 0;
         while started.elapsed().as_secs_f64() < duration_s + 5.0 {
-            match subscriber.next(Duration::from_millis(500)) {
+            match subscriber
+                .next(Duration::from_millis(500))
+                .expect("the daemon's alert service passes the owner checks")
+            {
                 Some(Received::Alert(alert)) => {
                     let latency_ns = wall_clock_now_ns() as f64 - alert.wall_time_ns as f64;
                     latencies_ms.push(latency_ns / 1e6);
                     round_alerts += 1;
                 }
                 Some(Received::Lost { first, last, .. }) => lost += last - first + 1,
+                Some(Received::Untrusted { sequence, .. }) => {
+                    panic!("untrusted alert #{sequence} from the daemon")
+                }
                 Some(Received::NewRun { .. }) | None => {}
             }
             if let Ok(Some(_)) = daemon.try_wait() {

@@ -14,11 +14,20 @@ It prints the alerts active when it subscribes (the service keeps them in its hi
 each alert as it comes, one JSON object per line. A gap in the sequence numbers means this
 subscriber fell behind and lost alerts: it says so. `--count N` exits 0 after N alerts,
 `--timeout S` exits 1 if they did not come in time.
+
+Run it as the daemon's user (`runuser -u bearingd -- python3 ...`). It trusts only what the
+kernel attests (docs/ALERTS.md, "Trust model"): the root, the service's and its wake event's
+files must belong to `--expect-uid` (default: this process's user), the service must take one
+publisher, and every live process on it must run as that user; else it exits 2 with the
+reason. A jump in the sequence numbers that no overflow explains is printed as "untrusted",
+not as an alert.
 """
 
 import argparse
 import ctypes
 import json
+import os
+import stat
 import sys
 import time
 
@@ -80,42 +89,147 @@ class Alert(ctypes.Structure):
 assert ctypes.sizeof(Alert) == 144 and ctypes.alignment(Alert) == 8
 
 
+class Untrusted(Exception):
+    """The root, the service or its publisher is not the expected user's."""
+
+
+def check_root(root: str, uid: int) -> bool:
+    """The root must be a directory (not a link) of `uid`, not writable by group or others.
+    False while it does not exist yet."""
+    try:
+        info = os.lstat(root)
+    except FileNotFoundError:
+        return False
+    if not stat.S_ISDIR(info.st_mode):
+        raise Untrusted(f"iceoryx2 root {root} is not a directory (a link or a file)")
+    if info.st_uid != uid:
+        raise Untrusted(f"iceoryx2 root {root} is owned by uid {info.st_uid}, not uid {uid}: run as the daemon's user (runuser -u bearingd -- ...)")
+    if info.st_mode & 0o022:
+        raise Untrusted(f"iceoryx2 root {root} is mode {stat.S_IMODE(info.st_mode):04o}: others may have planted services")
+    return True
+
+
+def proc_uid(pid: int):
+    """The effective uid of process `pid` (from /proc, not from the node's own records)."""
+    try:
+        with open(f"/proc/{pid}/status") as status:
+            for line in status:
+                if line.startswith("Uid:"):
+                    return int(line.split()[2])
+    except OSError:
+        return None
+    return None
+
+
+def verify(args, config, service, wake):
+    """The checks of bearingd's own subscriber (src/sinks/alerts/verify.rs), with what the
+    Python API offers: it lists no publishers, so every live node on the service must be of
+    the expected user."""
+    prefix = config.global_cfg.prefix.to_string()
+    for what, factory in ((args.service, service), (args.service + "/wake", wake)):
+        path = os.path.join(args.root, "services", f"{prefix}{factory.service_hash.as_str}.service")
+        try:
+            info = os.lstat(path)
+        except OSError as error:
+            raise Untrusted(f"{what}: its static file {path} cannot be looked at ({error})")
+        if not stat.S_ISREG(info.st_mode) or info.st_uid != args.expect_uid:
+            raise Untrusted(f"{what} was created by uid {info.st_uid} ({path}), not by uid {args.expect_uid}")
+    if service.static_config.max_publishers != 1 or wake.static_config.max_notifiers != 1:
+        raise Untrusted(f"{args.service} admits more than one publisher: bearingd did not make it")
+    if service.dynamic_config.number_of_publishers > 1:
+        raise Untrusted(f"{args.service} has {service.dynamic_config.number_of_publishers} publishers, not one")
+    for state in service.nodes:
+        if isinstance(state, iox.NodeState.Dead):
+            continue
+        if not isinstance(state, iox.NodeState.Alive):
+            raise Untrusted(f"{args.service}: a node this user cannot look at uses it ({state!r})")
+        details = state[0].details
+        pid = details.process_id if details is not None else None
+        uid = proc_uid(pid) if pid is not None else None
+        if uid != args.expect_uid:
+            raise Untrusted(f"{args.service}: pid {pid} on it runs as uid {uid}, not uid {args.expect_uid}")
+
+
 def open_service(args):
-    """Opens the daemon's alert service and its wake-up event; waits for the daemon."""
+    """Opens the daemon's alert service and its wake-up event once they exist and pass the
+    owner checks; waits for the daemon (until --timeout)."""
     config = iox.config.default()
     config.global_cfg.root_path = iox.Path.new(args.root)
     if args.prefix:
         config.global_cfg.prefix = iox.FileName.new(args.prefix)
-    node = (
-        iox.NodeBuilder.new()
-        .config(config)
-        .signal_handling_mode(iox.SignalHandlingMode.Disabled)
-        .create(iox.ServiceType.Ipc)
-    )
     deadline = time.monotonic() + args.timeout if args.timeout else None
     said = False
+    node = None
     while True:
         try:
-            service = (
-                node.service_builder(iox.ServiceName.new(args.service))
-                .publish_subscribe(Alert)
-                .open()
-            )
-            break
-        except Exception as error:  # the daemon has not created it yet
-            if deadline is not None and time.monotonic() > deadline:
-                sys.exit(f"alert service {args.service} under {args.root}: {error!r}; is bearingd running?")
-            if not said:
-                print(f"waiting for bearingd ({args.service} under {args.root}: {error!r})", file=sys.stderr)
-                said = True
-            time.sleep(0.5)
+            if check_root(args.root, args.expect_uid):
+                if node is None:
+                    node = (
+                        iox.NodeBuilder.new()
+                        .config(config)
+                        .signal_handling_mode(iox.SignalHandlingMode.Disabled)
+                        .create(iox.ServiceType.Ipc)
+                    )
+                service = (
+                    node.service_builder(iox.ServiceName.new(args.service))
+                    .publish_subscribe(Alert)
+                    .open()
+                )
+                # Opened, never created: the daemon makes it with its one notifier.
+                wake = node.service_builder(iox.ServiceName.new(args.service + "/wake")).event().open()
+                break
+            error = "the root does not exist yet"
+        except Untrusted:
+            raise
+        except Exception as failure:  # the daemon has not created it yet
+            error = repr(failure)
+        if deadline is not None and time.monotonic() > deadline:
+            sys.exit(f"alert service {args.service} under {args.root}: {error}; is bearingd running?")
+        if not said:
+            print(f"waiting for bearingd ({args.service} under {args.root}: {error})", file=sys.stderr)
+            said = True
+        time.sleep(0.5)
+    verify(args, config, service, wake)
     static = service.static_config
     history = static.history_size
     buffer = static.subscriber_max_buffer_size
     subscriber = service.subscriber_builder().buffer_size(buffer).history_request(min(history, buffer)).create()
-    wake = node.service_builder(iox.ServiceName.new(args.service + "/wake")).event().open_or_create()
     listener = wake.listener_builder().create()
-    return node, subscriber, listener
+    return node, subscriber, listener, buffer
+
+
+def judge(batch, last, expect_first, buffer):
+    """The sequence rule of src/sinks/alerts/sequence.rs for one drain pass: yields
+    ("alert" | "lost" | "new_run" | "untrusted", data) and returns the new `last`."""
+    out = []
+    for i, alert in enumerate(batch):
+        if last is not None and last[0] == alert.run_id:
+            expected, new_run = last[1] + 1, False
+        elif last is not None:
+            expected, new_run = 1, True
+        else:
+            expected, new_run = (1 if expect_first else None), False
+        lost = None
+        if expected is not None:
+            if alert.sequence < expected:
+                continue
+            if alert.sequence > expected:
+                tail = batch[i : i + buffer]
+                overflow = len(tail) >= buffer and all(
+                    a.run_id == alert.run_id and a.sequence == alert.sequence + k for k, a in enumerate(tail)
+                )
+                if not overflow:
+                    out.append(("untrusted", {"run_id": alert.run_id, "sequence": alert.sequence, "expected": expected}))
+                    continue
+                lost = {"run_id": alert.run_id, "first": expected, "last": alert.sequence - 1}
+        if new_run:
+            out.append(("new_run", {"run_id": alert.run_id}))
+        if lost:
+            out.append(("lost", lost))
+        last = (alert.run_id, alert.sequence)
+        expect_first = False
+        out.append(("alert", alert))
+    return out, last, expect_first
 
 
 def main() -> int:
@@ -123,31 +237,42 @@ def main() -> int:
     parser.add_argument("--root", default="/run/bearingd/iceoryx2", help="the daemon's outputs.iceoryx2_root")
     parser.add_argument("--service", default="bearingd/alerts", help="the daemon's outputs.alerts_service")
     parser.add_argument("--prefix", default=None, help="iceoryx2 file prefix (tests only)")
+    parser.add_argument("--expect-uid", type=int, default=os.geteuid(), help="the daemon's uid (default: this user's)")
     parser.add_argument("--count", type=int, default=None, help="exit after this many alerts")
     parser.add_argument("--timeout", type=float, default=None, help="give up after this many seconds")
     args = parser.parse_args()
 
-    node, subscriber, listener = open_service(args)
+    try:
+        node, subscriber, listener, buffer = open_service(args)
+    except Untrusted as refusal:
+        print(f"refused: {refusal}", file=sys.stderr)
+        return 2
     deadline = time.monotonic() + args.timeout if args.timeout else None
-    last = None  # (run_id, sequence) of the newest alert seen
+    last = None  # (run_id, sequence) of the newest alert accepted
+    expect_first = False
+    history_until = time.monotonic() + 0.4  # the daemon hands its history within ~50 ms
+    seen_any = False
     received = 0
     while deadline is None or time.monotonic() < deadline:
         # Sleep until the daemon signals an alert (at most 200 ms, so the deadline is kept).
         listener.timed_wait(iox.Duration.from_millis(200))
+        batch = []
         while (sample := subscriber.receive()) is not None:
-            alert = sample.payload().contents
+            alert = Alert.from_buffer_copy(sample.payload().contents)
             if alert.version != ALERT_VERSION:
                 print(f"alert layout version {alert.version} is not {ALERT_VERSION}: update this script", file=sys.stderr)
                 return 2
-            if last is not None and last[0] == alert.run_id:
-                if alert.sequence <= last[1]:
-                    continue
-                if alert.sequence > last[1] + 1:
-                    print(json.dumps({"type": "lost", "first": last[1] + 1, "last": alert.sequence - 1}), flush=True)
-            elif last is not None:
-                print(json.dumps({"type": "new_run", "run_id": alert.run_id}), flush=True)
-            last = (alert.run_id, alert.sequence)
-            record = alert.to_dict()
+            batch.append(alert)
+        if batch:
+            seen_any = True
+        elif not seen_any and last is None and time.monotonic() >= history_until:
+            expect_first = True  # an empty history: the daemon's next alert is number 1
+        verdicts, last, expect_first = judge(batch, last, expect_first, buffer)
+        for kind, data in verdicts:
+            if kind != "alert":
+                print(json.dumps({"type": kind, **data}), flush=True)
+                continue
+            record = data.to_dict()
             record["type"] = "alert"
             record["received_wall_ns"] = time.time_ns()
             print(json.dumps(record), flush=True)

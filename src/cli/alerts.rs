@@ -3,17 +3,24 @@
 //! It finds the service the way the daemon does: from the daemon's config
 //! (`outputs.alerts_service` under `outputs.iceoryx2_root`), or, without one, from the
 //! embedded default's data directory (`bearingd run` without `--config`). Lost alerts (this
-//! subscriber fell behind) and daemon restarts are printed, never passed over.
+//! subscriber fell behind), daemon restarts and untrusted sequence numbers are printed, never
+//! passed over.
+//!
+//! It runs as the daemon's user and checks that the root, the service and its publisher are
+//! that user's (`sinks::alerts::verify`); it never changes its own user (issue 32: it used to
+//! become the owner of the root directory, whoever made it). Root is told to use `runuser`.
 
 use super::run::embedded_config;
 use super::CliError;
 use crate::clock::wall_clock_now_ns;
 use crate::config;
+use crate::fsafe::effective_uid;
 use crate::iox::IoxSettings;
 use crate::messages::{FaultKind, FlagLevel};
 use crate::report::plain::flag_words;
 use crate::sinks::alerts::payload::AlertDecodeError;
 use crate::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
+use crate::sinks::alerts::AlertError;
 use crate::sinks::alerts::{Alert, AlertState, AlertView};
 use clap::Args;
 use std::collections::BTreeMap;
@@ -72,7 +79,10 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
     let mut subscriber = open_when_available(&settings, &left)?;
     // The history: the alerts active when we subscribed.
     let mut active: BTreeMap<(String, String, u8), Alert> = BTreeMap::new();
-    for received in subscriber.take_history(HISTORY_WAIT) {
+    for received in subscriber
+        .take_history(HISTORY_WAIT)
+        .map_err(CliError::input)?
+    {
         match received {
             Received::Alert(alert) => {
                 let view = match alert.view() {
@@ -111,7 +121,7 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
         if wait.is_zero() {
             break;
         }
-        match subscriber.next(wait) {
+        match subscriber.next(wait).map_err(CliError::input)? {
             Some(Received::Alert(alert)) => {
                 printer.alert(&alert, false);
                 if printer.done(args.count) {
@@ -132,16 +142,29 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
     }
 }
 
-/// Opens the service, waiting for the daemon to create it (until the deadline, if any).
+/// Opens the service, waiting for the daemon to create it (until the deadline, if any). It
+/// waits only while the root or the service is missing: a service or root that fails the
+/// owner checks is exit 2 at once.
 fn open_when_available(
     settings: &AlertServiceSettings,
     left: &impl Fn() -> Option<Duration>,
 ) -> Result<AlertSubscriber, CliError> {
+    let uid = effective_uid();
     let mut said = false;
     loop {
-        act_as_daemon_user(settings)?;
-        match AlertSubscriber::open(settings) {
+        match AlertSubscriber::open(settings, uid) {
             Ok(subscriber) => return Ok(subscriber),
+            Err(e @ AlertError::Untrusted { .. }) => {
+                return Err(CliError::input(match root_owner(settings) {
+                    Some(owner) if uid == 0 && owner != 0 => format!(
+                        "{e}. The alert service belongs to uid {owner}; iceoryx2 delivers only to \
+                         subscribers of that user, and bearingd alerts never changes its user by \
+                         itself: run `runuser -u <user of uid {owner}> -- bearingd alerts ...` \
+                         (under systemd: runuser -u bearingd -- bearingd alerts ...)"
+                    ),
+                    _ => e.to_string(),
+                }))
+            }
             Err(e) => {
                 if left().is_some_and(|l| l.is_zero()) {
                     return Err(CliError::failure(e));
@@ -160,60 +183,11 @@ fn open_when_available(
     }
 }
 
-/// When started as root, becomes the owner of the iceoryx2 root directory (the daemon's user,
-/// `bearingd` under systemd) once it exists.
-///
-/// Why: iceoryx2 0.10 creates its shared memory and sockets readable by their owner only, so
-/// the daemon (not root, no capabilities) cannot connect to a subscriber that root created:
-/// such a subscriber would silently receive nothing. Nothing is done for other users; they
-/// must run as the daemon's user themselves (`sudo -u bearingd bearingd alerts`).
-#[allow(
-    unsafe_code,
-    reason = "geteuid, setgroups, setgid and setuid have no safe std API"
-)]
-fn act_as_daemon_user(settings: &AlertServiceSettings) -> Result<(), CliError> {
+/// The owner of the iceoryx2 root (not following a link), if it can be looked at.
+fn root_owner(settings: &AlertServiceSettings) -> Option<u32> {
     use std::os::unix::fs::MetadataExt;
-    // SAFETY: geteuid has no preconditions.
-    if unsafe { libc::geteuid() } != 0 {
-        return Ok(());
-    }
-    let Some(root) = settings.iox.root_path.as_deref() else {
-        return Ok(());
-    };
-    let Ok(meta) = std::fs::metadata(root) else {
-        return Ok(()); // not created yet: the daemon has not started
-    };
-    if meta.uid() == 0 {
-        return Ok(());
-    }
-    let fail = |what: &str| {
-        CliError::failure(format!(
-            "cannot switch to the owner (uid {}, gid {}) of the iceoryx2 root {root} ({what}: {}); \
-             run as that user instead, e.g. sudo -u bearingd bearingd alerts ...",
-            meta.uid(),
-            meta.gid(),
-            std::io::Error::last_os_error()
-        ))
-    };
-    // SAFETY: plain system calls on integers; the order (groups, gid, then uid) is the one
-    // that leaves no root privilege behind.
-    unsafe {
-        if libc::setgroups(0, std::ptr::null()) != 0 {
-            return Err(fail("setgroups"));
-        }
-        if libc::setgid(meta.gid()) != 0 {
-            return Err(fail("setgid"));
-        }
-        if libc::setuid(meta.uid()) != 0 {
-            return Err(fail("setuid"));
-        }
-    }
-    eprintln!(
-        "bearingd alerts: running as uid {} (the owner of {root}, the daemon's user), so the \
-         daemon can deliver to this subscriber",
-        meta.uid()
-    );
-    Ok(())
+    let root = settings.iox.root_path.as_deref()?;
+    std::fs::symlink_metadata(root).ok().map(|m| m.uid())
 }
 
 /// What a bearing fault's alert means for the technician (`None` for the velocity zone's,
@@ -286,6 +260,17 @@ impl Printer {
             Received::NewRun { run_id } => (
                 serde_json::json!({"type": "new_run", "run_id": run_id}),
                 format!("the daemon restarted (run {run_id}); alert numbers start again"),
+            ),
+            Received::Untrusted {
+                run_id,
+                sequence,
+                expected,
+            } => (
+                serde_json::json!({"type": "untrusted", "run_id": run_id, "sequence": sequence, "expected": expected}),
+                format!(
+                    "UNTRUSTED alert #{sequence} of run {run_id}: #{expected} was next and no \
+                     overflow explains the jump (forged or corrupt?); not shown, numbering kept"
+                ),
             ),
             Received::Alert(_) => return,
         };

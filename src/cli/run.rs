@@ -309,9 +309,18 @@ pub(super) fn event_line(event: &DaemonEvent) -> String {
             "bearingd: iceoryx2 root {} was mode {from:04o}: now 0700 (only bearingd's user may use it)",
             root.display()
         ),
-        DaemonEvent::AlertsOn { service, root } => format!(
-            "bearingd: alerts on iceoryx2 service {service} (root {})",
-            root.display()
+        DaemonEvent::AlertsOn {
+            service,
+            root,
+            reopened,
+        } => format!(
+            "bearingd: alerts on iceoryx2 service {service} (root {}){}",
+            root.display(),
+            if *reopened {
+                "; reopened our previous run's service, kept alive by its subscribers"
+            } else {
+                ""
+            }
         ),
         #[cfg(feature = "shm")]
         DaemonEvent::DeadIoxNode { root, node } => match &node.removed {

@@ -44,7 +44,13 @@ pub enum DaemonEvent {
     /// or by iceoryx2, `0750`): it is now `0700`.
     IoxRootTightened { root: PathBuf, from: u32 },
     /// The alert service is up.
-    AlertsOn { service: String, root: PathBuf },
+    /// `reopened`: the service was this user's previous run's, kept alive by connected
+    /// subscribers, and of our shape: opened again, not created (issue 32).
+    AlertsOn {
+        service: String,
+        root: PathBuf,
+        reopened: bool,
+    },
     /// A dead iceoryx2 node under the root (a killed daemon's, or a killed publisher's): its
     /// resources were removed at start, or could not be.
     #[cfg(feature = "shm")]

@@ -385,6 +385,7 @@ fn start_alerts(config: &Config, events: &Events) -> Result<Option<AlertSink>, R
     events(DaemonEvent::AlertsOn {
         service: config.outputs.alerts_service.clone(),
         root: config.outputs.iceoryx2_root.clone(),
+        reopened: alerts.reopened(),
     });
     Ok(Some(alerts))
 }

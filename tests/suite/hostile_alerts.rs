@@ -1,13 +1,18 @@
-//! Hostile neighbours of the alert service (issue 32, item 2): what others may leave at the
-//! iceoryx2 root's path. The real `bearingd` binary runs as a second process on a root the
-//! test planted: it must refuse it with the fix, before any log file exists (a refused start
-//! used to leave an empty log behind, one per restart), and never follow a link there.
+//! Hostile neighbours of the alert service (issue 32, items 1 and 2): what others may leave at
+//! the iceoryx2 root's path, and other processes on the service itself. The real `bearingd`
+//! binary runs as a second process on a root the test planted: it must refuse it with the fix,
+//! before any log file exists (a refused start used to leave an empty log behind, one per
+//! restart), and never follow a link there. A forger (`tests/python/forge_alert.py`, a
+//! process of the same user) can neither publish beside the daemon nor hold the service
+//! before it; `bearingd alerts` and the Python example refuse a root of another user.
 
 use super::hostile_files::{config, run_daemon};
 use crate::cli::stderr as stderr_of;
 use bearingd_testdata::{iox_root, mcap_files, scratch_dir};
 use std::os::unix::fs::{symlink, PermissionsExt};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
 
 /// Runs the daemon twice (a restart loop) on `data` and checks each start is refused with exit
 /// 2, an error containing every one of `expected`, and no log left.
@@ -99,18 +104,9 @@ fn the_daemons_own_0750_root_is_tightened_to_0700_and_the_run_goes_on() {
 /// naming the owner and the fix, and leaves no log. Needs root to act as the other user.
 #[test]
 fn a_root_another_user_made_first_is_refused_naming_its_owner() {
-    if !is_root() {
-        assert!(
-            std::env::var("CI").as_deref() != Ok("true"),
-            "this test needs root (setpriv to another uid); run the suite as root"
-        );
-        eprintln!("skipped: not root, cannot act as another user");
+    let Some(other) = other_uid() else {
         return;
-    }
-    let other: u32 = std::env::var("BEARINGD_TEST_OTHER_UID")
-        .ok()
-        .and_then(|u| u.parse().ok())
-        .unwrap_or(61032);
+    };
     let dir = scratch_dir("hostile-root-foreign");
     let config = config(&dir, "hrf");
     let shared = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrf");
@@ -118,9 +114,8 @@ fn a_root_another_user_made_first_is_refused_naming_its_owner() {
     std::fs::create_dir_all(&shared).unwrap();
     std::fs::set_permissions(&shared, std::fs::Permissions::from_mode(0o1777)).unwrap();
     let root = shared.join("r");
-    let made = std::process::Command::new("setpriv")
-        .args([&format!("--reuid={other}"), &format!("--regid={other}")])
-        .args(["--clear-groups", "--", "mkdir", "-m", "0777"])
+    let made = as_user(other, "mkdir")
+        .args(["-m", "0777"])
         .arg(&root)
         .status()
         .expect("run setpriv (util-linux)");
@@ -152,6 +147,35 @@ fn a_root_another_user_made_first_is_refused_naming_its_owner() {
     std::fs::remove_dir_all(&shared).unwrap();
 }
 
+/// The uid to act as another user (`$BEARINGD_TEST_OTHER_UID`, default 61032, no passwd
+/// entry needed), when this test runs as root; else `None` (said), or a failure under CI=true.
+pub(super) fn other_uid() -> Option<u32> {
+    if !is_root() {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "this test needs root (setpriv to another uid); run the suite as root"
+        );
+        eprintln!("skipped: not root, cannot act as another user");
+        return None;
+    }
+    Some(
+        std::env::var("BEARINGD_TEST_OTHER_UID")
+            .ok()
+            .and_then(|u| u.parse().ok())
+            .unwrap_or(61032),
+    )
+}
+
+/// `program` run as `uid` (and its gid, no supplementary groups) through setpriv.
+pub(super) fn as_user(uid: u32, program: impl AsRef<std::ffi::OsStr>) -> Command {
+    let mut command = Command::new("setpriv");
+    command
+        .args([&format!("--reuid={uid}"), &format!("--regid={uid}")])
+        .args(["--clear-groups", "--"])
+        .arg(program);
+    command
+}
+
 fn is_root() -> bool {
     let status = std::fs::read_to_string("/proc/self/status").unwrap();
     status
@@ -159,4 +183,236 @@ fn is_root() -> bool {
         .find_map(|l| l.strip_prefix("Uid:"))
         .and_then(|ids| ids.split_whitespace().nth(1))
         == Some("0")
+}
+
+/// The forger, `tests/python/forge_alert.py`, on `root` (the .venv's Python with iceoryx2).
+fn forger(root: &Path) -> Option<Command> {
+    let python = bearingd_testdata::python_iceoryx2()?;
+    let mut command = Command::new(python);
+    command
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/forge_alert.py"))
+        .arg("--root")
+        .arg(root);
+    Some(command)
+}
+
+/// The daemon of `config` in real time for up to `seconds`, once its alert service exists.
+fn live_daemon(config: &Path, data: &Path, root: &Path, seconds: &str) -> Child {
+    let mut daemon = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(["run", "--quiet", "--duration", seconds, "--config"])
+        .arg(config)
+        .arg("--data-dir")
+        .arg(data)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let services = root.join("services");
+    let start = Instant::now();
+    while std::fs::read_dir(&services).map_or(0, |d| d.count()) < 2 {
+        if let Ok(Some(status)) = daemon.try_wait() {
+            let out = daemon.wait_with_output().unwrap();
+            panic!("daemon ended ({status}): {}", stderr_of(&out));
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no alert service"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    daemon
+}
+
+fn stop(daemon: Child) -> std::process::Output {
+    let _ = Command::new("kill")
+        .args(["-TERM", &daemon.id().to_string()])
+        .status();
+    daemon.wait_with_output().unwrap()
+}
+
+/// `bearingd alerts --json` of `config` for `seconds`.
+fn alerts_json(config: &Path, seconds: &str) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(["alerts", "--json", "--timeout", seconds, "--config"])
+        .arg(config)
+        .output()
+        .unwrap()
+}
+
+/// A process of the daemon's own user tries to publish a forged inner-race alarm (and a
+/// forged huge sequence number, and a forged "cleared") while the daemon runs: iceoryx2
+/// refuses it a publisher (the service has one, the daemon's), and `bearingd alerts` shows
+/// nothing of it. Before issue 32 the service took two publishers and the forgery was shown.
+#[test]
+fn a_forger_of_the_daemons_user_cannot_publish_beside_it() {
+    let dir = scratch_dir("hostile-forger");
+    let config = config(&dir, "hfg");
+    let root = iox_root(env!("CARGO_TARGET_TMPDIR"), "hfg");
+    let Some(_) = forger(&root) else {
+        return;
+    };
+    let daemon = live_daemon(&config, &dir.join("data"), &root, "60");
+    let forgeries: [&[&str]; 3] = [
+        &["--sequence", "1", "--state", "raised"],
+        &["--sequence", "1000000000", "--state", "raised"],
+        &["--sequence", "2", "--state", "cleared", "--severity", "ok"],
+    ];
+    let mut results = Vec::new();
+    for args in forgeries {
+        let out = forger(&root)
+            .unwrap()
+            .args(["--publish", "--hold", "3", "--run-id", "1"])
+            .args(args)
+            .output()
+            .unwrap();
+        results.push(out);
+    }
+    let seen = alerts_json(&config, "2");
+    let out = stop(daemon);
+    assert!(out.status.success(), "daemon: {}", stderr_of(&out));
+    for (args, result) in forgeries.iter().zip(&results) {
+        let text = String::from_utf8_lossy(&result.stdout);
+        assert_eq!(
+            result.status.code(),
+            Some(3),
+            "forger {args:?} was not refused: {text} {}",
+            stderr_of(result)
+        );
+        assert!(text.contains("refused"), "{text}");
+    }
+    let text = String::from_utf8_lossy(&seen.stdout);
+    assert!(!text.contains("forged") && !text.contains("lost"), "{text}");
+}
+
+/// A live process of the same user that made the service first, of another shape: the daemon
+/// refuses to start, naming its pid and program and the fix; once it is killed (`kill -9`,
+/// nothing cleaned), the daemon removes the dead node and starts.
+#[test]
+fn a_service_held_by_a_live_forger_is_refused_naming_it_and_cleaned_once_it_died() {
+    let dir = scratch_dir("hostile-holder");
+    let config = config(&dir, "hho");
+    let root = iox_root(env!("CARGO_TARGET_TMPDIR"), "hho");
+    let Some(mut holder) = forger(&root) else {
+        return;
+    };
+    std::fs::create_dir_all(&root).unwrap();
+    std::fs::set_permissions(&root, std::fs::Permissions::from_mode(0o700)).unwrap();
+    let mut holder = holder
+        .args(["--create", "--shape", "bad", "--hold", "60"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut ready = String::new();
+    std::io::BufRead::read_line(
+        &mut std::io::BufReader::new(holder.stdout.as_mut().unwrap()),
+        &mut ready,
+    )
+    .unwrap();
+    assert_eq!(ready.trim(), "ready");
+    let pid = holder.id().to_string();
+    refused_twice(
+        &config,
+        &dir.join("data"),
+        &[
+            &format!("pid {pid} (python3"),
+            "another shape",
+            "outputs.alerts_service",
+        ],
+    );
+    holder.kill().unwrap();
+    holder.wait().unwrap();
+    let out = run_daemon(&config, &dir.join("data"), "022");
+    let err = stderr_of(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("pid {pid}")),
+        "the dead node is not said: {err}"
+    );
+}
+
+/// Root's `bearingd alerts` facing a root another user made (0700, as a daemon of that user
+/// would): it refuses with the `runuser` fix, and never becomes that user (it used to setuid to
+/// the owner of the directory). The Python example refuses it too.
+#[test]
+fn roots_subscribers_refuse_another_users_root_and_never_switch_to_it() {
+    let Some(other) = other_uid() else {
+        return;
+    };
+    let dir = scratch_dir("hostile-root-sub");
+    let config = config(&dir, "hrs");
+    let shared = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrs");
+    let _ = std::fs::remove_dir_all(&shared);
+    std::fs::create_dir_all(&shared).unwrap();
+    std::fs::set_permissions(&shared, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    let root: PathBuf = shared.join("r");
+    let made = as_user(other, "mkdir")
+        .args(["-m", "0700"])
+        .arg(&root)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let text = std::fs::read_to_string(&config).unwrap().replace(
+        &format!("\"{}\"", shared.display()),
+        &format!("\"{}\"", root.display()),
+    );
+    std::fs::write(&config, text).unwrap();
+    let out = alerts_json(&config, "3");
+    let err = stderr_of(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(&format!("uid {other}")), "{err}");
+    assert!(err.contains("runuser -u"), "{err}");
+    assert!(!err.contains("running as uid"), "{err}");
+    if let Some(python) = bearingd_testdata::python_iceoryx2() {
+        let out = Command::new(python)
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/alerts_subscriber.py"))
+            .arg("--root")
+            .arg(&root)
+            .args(["--timeout", "3"])
+            .output()
+            .unwrap();
+        let err = stderr_of(&out);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(&format!("uid {other}")), "{err}");
+    }
+    std::fs::remove_dir_all(&shared).unwrap();
+}
+
+/// Guard (worked before issue 32 and must still work): the daemon killed (`kill -9`) and
+/// restarted while `bearingd alerts` stays connected. The connected subscriber keeps the
+/// service alive, so the new daemon removes the dead node, reopens its own previous service
+/// (same user, same shape) and says so; the subscriber's checks accept the new publisher.
+#[test]
+fn a_daemon_killed_and_restarted_under_a_connected_subscriber_reopens_its_service() {
+    let dir = scratch_dir("hostile-restart");
+    let config = config(&dir, "hre");
+    let root = iox_root(env!("CARGO_TARGET_TMPDIR"), "hre");
+    let data = dir.join("data");
+    let mut first = live_daemon(&config, &data, &root, "60");
+    let subscriber = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+        .args(["alerts", "--json", "--timeout", "10", "--config"])
+        .arg(&config)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(Duration::from_secs(2));
+    first.kill().unwrap();
+    first.wait().unwrap();
+    let second = live_daemon(&config, &data, &root, "60");
+    std::thread::sleep(Duration::from_secs(3));
+    let out = stop(second);
+    let err = stderr_of(&out);
+    let seen = subscriber.wait_with_output().unwrap();
+    let seen_err = stderr_of(&seen);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("reopened our previous run's service"), "{err}");
+    assert!(
+        err.contains("removed the stale resources of a dead"),
+        "{err}"
+    );
+    assert!(
+        !seen_err.contains("not to be trusted"),
+        "the subscriber refused the restarted daemon: {seen_err}"
+    );
+    assert_eq!(seen.status.code(), Some(0), "{seen_err}");
 }

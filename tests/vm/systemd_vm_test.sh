@@ -10,7 +10,8 @@
 #   active     bearingd reached "active" (Type=notify: READY=1 sent) and reports STATUS=
 #   cpu-latency  bearingd holds /dev/cpu_dma_latency open (outputs.cpu_wakeup_latency_us = 50)
 #              through the unit's sandbox, the device's group set by the installed tmpfiles.d
-#   alert      `bearingd alerts --json --count 1`, started as root, received the outer-race
+#   alert-root-refused  `bearingd alerts` started as root exits 2 with the runuser fix
+#   alert      `bearingd alerts --json --count 1`, as user bearingd, received the outer-race
 #              alert, state "raised"
 #   alert-history  a late `bearingd alerts` as user bearingd got the active alert from history
 #   status-flag  the flag shows in the STATUS= line bearingd sends systemd
@@ -223,7 +224,7 @@ echo "VMTEST mcap: $mcap_ok $mcap_detail" | tee -a "$WORK/host-verdicts.log"
 # 9. Verdict: every expected line present, none failed.
 status=0
 cat "$WORK/host-verdicts.log" >> "$WORK/serial.txt"
-for check in install active cpu-latency alert alert-history status-flag stop mcap-sent mcap; do
+for check in install active cpu-latency alert-root-refused alert alert-history status-flag stop mcap-sent mcap; do
   line=$(grep -a -m1 "^VMTEST $check: " "$WORK/serial.txt" || true)
   case "$line" in
     "VMTEST $check: PASS"*) ;;

@@ -13,6 +13,8 @@
 #![forbid(unsafe_code)]
 #![cfg_attr(test, allow(clippy::unwrap_used, clippy::expect_used))]
 
+#[cfg(feature = "iceoryx2")]
+pub mod owner;
 pub mod payload;
 
 pub use payload::{

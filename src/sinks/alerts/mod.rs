@@ -8,15 +8,20 @@
 //!
 //! - [`payload`]: the `#[repr(C)]` record and its readable view.
 //! - [`tracker`]: flag changes → alerts (sans-IO).
+//! - [`sequence`]: a subscriber's check of sequence numbers (sans-IO): losses, duplicates,
+//!   restarts, and jumps that cannot be trusted.
 //! - [`service`]: the iceoryx2 publisher and subscriber.
 //! - [`AlertSink`]: the tracker and the publisher as the daemon drives them, on the analysis
 //!   thread: an alert leaves as soon as it is decided, never behind the MCAP log or another
 //!   thread's wake-up.
 
 pub mod payload;
+pub mod sequence;
 #[cfg(feature = "shm")]
 pub mod service;
 pub mod tracker;
+#[cfg(feature = "shm")]
+mod verify;
 
 pub use payload::{Alert, AlertState, AlertView};
 #[cfg(feature = "shm")]
@@ -72,6 +77,12 @@ impl AlertSink {
                 failed(e);
             }
         });
+    }
+
+    /// Whether the service was a previous run's of this user, reopened (see
+    /// [`AlertPublisher::reopened`]).
+    pub fn reopened(&self) -> bool {
+        self.publisher.reopened
     }
 
     /// Takes a twin fit made on the re-fit thread (its confidence weighs in on later alerts).

@@ -8,8 +8,14 @@
 //!   subscriber receives the active alerts), a subscriber buffer of [`SUBSCRIBER_BUFFER`]
 //!   alerts, and safe overflow: a subscriber that does not keep up loses its oldest alerts,
 //!   never the newest, and sees the loss as a gap in `sequence` ([`Received::Lost`]);
+//!   one publisher at most, the daemon's;
 //! - event `<alerts_service>/wake`, notified after every alert, so a subscriber sleeps in the
-//!   kernel instead of polling.
+//!   kernel instead of polling; one notifier at most.
+//!
+//! Authenticity (issue 32, docs/ALERTS.md "Trust model"): the daemon creates both exclusively
+//! and never opens a service another process created ([`AlertError::Taken`] names its owner);
+//! the subscriber checks that the root, both services and the publisher belong to the
+//! expected user (`verify.rs`) and judges sequence numbers with `sequence.rs`.
 //!
 //! The daemon publishes on the thread that decides the alert (the analysis thread): iceoryx2's
 //! send and notify never block, and no other thread has to wake up before the alert leaves.
@@ -19,10 +25,17 @@
 //! [`CONNECTION_PERIOD`], also while no alert is sent.
 
 use super::payload::Alert;
+pub use super::sequence::Received;
+use super::sequence::SequenceCheck;
+use super::verify::verify_service;
 use super::PublisherSummary;
-use crate::iox::{create_node, open_event_service, wake_service, IoxSettings};
+use crate::iox::owner::{claim, inspect, Claim, Taken};
+use crate::iox::{create_node, wake_service, IoxSettings};
 use iceoryx2::port::update_connections::UpdateConnections;
 use iceoryx2::prelude::*;
+use iceoryx2::service::port_factory::event::PortFactory as EventFactory;
+use iceoryx2::service::port_factory::publish_subscribe::PortFactory as PubSubFactory;
+use iceoryx2::service::static_config::StaticConfig;
 use std::sync::mpsc;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
@@ -40,6 +53,21 @@ type Shared = ipc_threadsafe::Service;
 pub enum AlertError {
     #[error("alert service {service}: {detail}")]
     Service { service: String, detail: String },
+    /// The service (or its wake event) exists and is not this daemon's to use.
+    #[error("alert service {service} (iceoryx2 root {root}): {why}; {owners}. bearingd never opens a service another process created: stop that process, or give this daemon its own outputs.alerts_service")]
+    Taken {
+        service: String,
+        root: String,
+        why: String,
+        owners: String,
+    },
+    /// A subscriber's check of the service or of its publisher failed.
+    #[error("alert service {service} (iceoryx2 root {root}) is not to be trusted: {why}")]
+    Untrusted {
+        service: String,
+        root: String,
+        why: String,
+    },
     #[error("alert keeper thread: {0}")]
     Thread(String),
     #[error("alert #{sequence} could not be published on {service}: {detail}")]
@@ -70,6 +98,49 @@ impl AlertServiceSettings {
         }
     }
 
+    fn untrusted(&self, why: String) -> AlertError {
+        AlertError::Untrusted {
+            service: self.service.clone(),
+            root: self.iox.root_name().to_string(),
+            why,
+        }
+    }
+
+    fn taken(&self, name: &str, taken: Taken) -> AlertError {
+        AlertError::Taken {
+            service: name.to_string(),
+            root: self.iox.root_name().to_string(),
+            why: taken.why,
+            owners: taken.owners.to_string(),
+        }
+    }
+
+    /// [`claim`] for `name`, a refusal as [`AlertError::Taken`].
+    fn claim(
+        &self,
+        name: &str,
+        pattern: MessagingPattern,
+        fits: impl Fn(&StaticConfig) -> bool,
+    ) -> Result<Claim, AlertError> {
+        claim(&self.iox, name, pattern, fits)
+            .map_err(|e| self.error(e.to_string()))?
+            .map_err(|taken| self.taken(name, taken))
+    }
+
+    /// What to say when iceoryx2 refuses an exclusive creation: someone made it in between.
+    fn lost_race(&self, name: &str, pattern: MessagingPattern, detail: String) -> AlertError {
+        match inspect(&self.iox, name, pattern) {
+            Ok(Some((_, owners))) => self.taken(
+                name,
+                Taken {
+                    owners,
+                    why: format!("another process created it at the same time ({detail})"),
+                },
+            ),
+            _ => self.error(format!("create: {detail}")),
+        }
+    }
+
     fn service_name(&self) -> Result<ServiceName, AlertError> {
         ServiceName::new(&self.service).map_err(|e| self.error(format!("invalid name: {e:?}")))
     }
@@ -77,6 +148,9 @@ impl AlertServiceSettings {
 
 /// The daemon's side: [`send`](Self::send) publishes at once, on the caller's thread.
 pub struct AlertPublisher {
+    /// The service was a previous run's of this user, kept alive by its subscribers (see
+    /// [`create_owned_alerts`]): reopened, not created.
+    pub reopened: bool,
     settings: AlertServiceSettings,
     publisher: Arc<iceoryx2::port::publisher::Publisher<Shared, Alert, ()>>,
     wake: iceoryx2::port::notifier::Notifier<Shared>,
@@ -98,32 +172,33 @@ impl AlertPublisher {
     ) -> Result<AlertPublisher, AlertError> {
         let node =
             create_node::<Shared>(&settings.iox).map_err(|e| settings.error(e.to_string()))?;
-        let service = node
-            .service_builder(&settings.service_name()?)
-            .publish_subscribe::<Alert>()
-            .history_size(history_size)
-            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER.max(history_size))
-            .enable_safe_overflow(true)
-            .max_publishers(2)
-            .max_subscribers(16)
-            .open_or_create()
-            .map_err(|e| {
-                settings.error(format!(
-                    "open or create: {e:?}; if another bearingd uses this service name, give \
-                     each its own outputs.alerts_service"
-                ))
-            })?;
-        let publisher = Arc::new(
-            service
-                .publisher_builder()
-                .create()
-                .map_err(|e| settings.error(format!("create publisher: {e:?}")))?,
-        );
-        let wake = open_event_service(&node, &settings.wake_name())
-            .map_err(|e| settings.error(e.to_string()))?
+        let (service, reopened) = create_owned_alerts(&node, &settings, history_size)?;
+        let publisher = Arc::new(service.publisher_builder().create().map_err(|e| {
+            // Only a second publisher can be refused here (max_publishers 1).
+            match inspect(
+                &settings.iox,
+                &settings.service,
+                MessagingPattern::PublishSubscribe,
+            ) {
+                Ok(Some((_, owners))) => settings.taken(
+                    &settings.service,
+                    Taken {
+                        owners,
+                        why: format!("another process publishes on it ({e:?})"),
+                    },
+                ),
+                _ => settings.error(format!("create publisher: {e:?}")),
+            }
+        })?);
+        let wake = create_owned_wake(&node, &settings)?
             .notifier_builder()
             .create()
-            .map_err(|e| settings.error(format!("create notifier: {e:?}")))?;
+            .map_err(|e| {
+                settings.error(format!(
+                    "create notifier: {e:?} (another process notifies on {})",
+                    settings.wake_name()
+                ))
+            })?;
         let (stop_keeper, stopped) = mpsc::sync_channel::<()>(0);
         let keeper = {
             let publisher = Arc::clone(&publisher);
@@ -140,6 +215,7 @@ impl AlertPublisher {
                 .map_err(|e| AlertError::Thread(e.to_string()))?
         };
         Ok(AlertPublisher {
+            reopened,
             settings,
             publisher,
             wake,
@@ -182,39 +258,128 @@ impl AlertPublisher {
     }
 }
 
-/// What a subscriber takes from the service.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Received {
-    Alert(Alert),
-    /// Alerts `first..=last` of the run never arrived: the subscriber's buffer overflowed.
-    Lost {
-        run_id: u64,
-        first: u64,
-        last: u64,
-    },
-    /// The daemon restarted (a new run id); sequence numbers start again.
-    NewRun {
-        run_id: u64,
-    },
+/// The alert service, created exclusively: iceoryx2 refuses a second creator, and one
+/// publisher at most (`max_publishers(1)`), so no other process, even of this user, can
+/// publish beside the daemon. The one service reopened is a previous run's of this user of the
+/// same shape, kept alive by connected subscribers (a restart under `bearingd alerts`); its
+/// single publisher slot still refuses a live one. Returns whether it was reopened.
+fn create_owned_alerts(
+    node: &Node<Shared>,
+    settings: &AlertServiceSettings,
+    history_size: usize,
+) -> Result<(PubSubFactory<Shared, Alert, ()>, bool), AlertError> {
+    let claim = settings.claim(
+        &settings.service,
+        MessagingPattern::PublishSubscribe,
+        |config| fits_alerts(config, history_size),
+    )?;
+    let builder = node
+        .service_builder(&settings.service_name()?)
+        .publish_subscribe::<Alert>();
+    match claim {
+        Claim::Create => builder
+            .history_size(history_size)
+            .subscriber_max_buffer_size(SUBSCRIBER_BUFFER.max(history_size))
+            .enable_safe_overflow(true)
+            .max_publishers(1)
+            .max_subscribers(16)
+            .create()
+            .map(|service| (service, false))
+            .map_err(|e| {
+                settings.lost_race(
+                    &settings.service,
+                    MessagingPattern::PublishSubscribe,
+                    format!("{e:?}"),
+                )
+            }),
+        Claim::Reopen(_) => builder
+            .open()
+            .map(|service| (service, true))
+            .map_err(|e| settings.error(format!("reopen our previous service: {e:?}"))),
+    }
+}
+
+/// Whether a found service has the shape [`create_owned_alerts`] gives: our payload, one
+/// publisher, safe overflow and a history of at least `history_size`.
+fn fits_alerts(config: &StaticConfig, history_size: usize) -> bool {
+    use iceoryx2::service::static_config::messaging_pattern::MessagingPattern as Shape;
+    let Shape::PublishSubscribe(ps) = config.messaging_pattern() else {
+        return false;
+    };
+    let payload = &ps.message_type_details().payload;
+    ps.max_publishers() == 1
+        && ps.has_safe_overflow()
+        && ps.history_size() >= history_size
+        && *payload.type_name() == ALERT_TYPE_NAME
+        && payload.size() == std::mem::size_of::<Alert>()
+}
+
+/// The payload's iceoryx2 type name (`type_name(...)` on [`Alert`]).
+const ALERT_TYPE_NAME: &str = "bearingd::Alert";
+
+/// The wake event of the alert service, by the same rule: created with one notifier at most,
+/// or reopened when it is this user's of that shape.
+fn create_owned_wake(
+    node: &Node<Shared>,
+    settings: &AlertServiceSettings,
+) -> Result<EventFactory<Shared>, AlertError> {
+    use iceoryx2::service::static_config::messaging_pattern::MessagingPattern as Shape;
+    let name = settings.wake_name();
+    let claim = settings.claim(
+        &name,
+        MessagingPattern::Event,
+        |config| matches!(config.messaging_pattern(), Shape::Event(e) if e.max_notifiers() == 1),
+    )?;
+    let service_name =
+        crate::iox::service_name(&name).map_err(|e| settings.error(e.to_string()))?;
+    let builder = node.service_builder(&service_name).event();
+    match claim {
+        Claim::Create => builder
+            .max_notifiers(1)
+            .create()
+            .map_err(|e| settings.lost_race(&name, MessagingPattern::Event, format!("{e:?}"))),
+        Claim::Reopen(_) => builder
+            .open()
+            .map_err(|e| settings.error(format!("reopen our previous {name}: {e:?}"))),
+    }
 }
 
 /// The subscriber's side of the service.
 pub struct AlertSubscriber {
-    _node: Node<ipc::Service>,
+    settings: AlertServiceSettings,
+    /// The user the service and its publisher must belong to.
+    expected_uid: u32,
+    /// The number of publishers when last verified: a change is verified again.
+    publishers: usize,
     subscriber: iceoryx2::port::subscriber::Subscriber<ipc::Service, Alert, ()>,
     wake: iceoryx2::port::listener::Listener<ipc::Service>,
-    last: Option<(u64, u64)>,
-    /// The next alert of a run is expected to be its first (sequence 1): the history was
-    /// empty when we subscribed, or a new run began.
-    expect_first: bool,
+    service: PubSubFactory<ipc::Service, Alert, ()>,
+    _node: Node<ipc::Service>,
+    sequence: SequenceCheck,
     pending: std::collections::VecDeque<Received>,
     /// The service's history size: how many alerts a new subscriber is handed.
     pub history_size: usize,
 }
 
 impl AlertSubscriber {
-    /// Opens the service; fails if the daemon has not created it (yet).
-    pub fn open(settings: &AlertServiceSettings) -> Result<AlertSubscriber, AlertError> {
+    /// Opens the service and checks that it, its wake event and its publisher belong to
+    /// `expected_uid` (see `verify.rs`): [`AlertError::Untrusted`] when not; another error when
+    /// the root or the service does not exist (yet).
+    pub fn open(
+        settings: &AlertServiceSettings,
+        expected_uid: u32,
+    ) -> Result<AlertSubscriber, AlertError> {
+        if let Some(root) = &settings.iox.root_path {
+            match crate::fsafe::check_private_root(std::path::Path::new(root), expected_uid) {
+                Ok(()) => {}
+                Err(crate::fsafe::UnsafeDir::Io { source, .. })
+                    if source.kind() == std::io::ErrorKind::NotFound =>
+                {
+                    return Err(settings.error("the iceoryx2 root does not exist (yet)"));
+                }
+                Err(e) => return Err(settings.untrusted(e.to_string())),
+            }
+        }
         let node = create_node(&settings.iox).map_err(|e| settings.error(e.to_string()))?;
         let service = node
             .service_builder(&settings.service_name()?)
@@ -226,6 +391,27 @@ impl AlertSubscriber {
                      path and service name must be the daemon's)"
                 ))
             })?;
+        // Opened, never created: the daemon makes it with its one notifier.
+        let wake_name = settings.wake_name();
+        let wake = node
+            .service_builder(
+                &crate::iox::service_name(&wake_name).map_err(|e| settings.error(e.to_string()))?,
+            )
+            .event()
+            .open()
+            .map_err(|e| settings.error(format!("cannot open {wake_name} ({e:?})")))?
+            .listener_builder()
+            .create()
+            .map_err(|e| settings.error(format!("create listener: {e:?}")))?;
+        let publishers = service.dynamic_config().number_of_publishers();
+        verify_service(
+            &settings.iox,
+            &settings.service,
+            &wake_name,
+            &service,
+            expected_uid,
+        )
+        .map_err(|why| settings.untrusted(why))?;
         let history_size = service.static_config().history_size();
         let buffer = service.static_config().subscriber_max_buffer_size();
         let subscriber = service
@@ -234,17 +420,15 @@ impl AlertSubscriber {
             .history_request(history_size.min(buffer))
             .create()
             .map_err(|e| settings.error(format!("create subscriber: {e:?}")))?;
-        let wake = open_event_service(&node, &settings.wake_name())
-            .map_err(|e| settings.error(e.to_string()))?
-            .listener_builder()
-            .create()
-            .map_err(|e| settings.error(format!("create listener: {e:?}")))?;
         Ok(AlertSubscriber {
-            _node: node,
+            settings: settings.clone(),
+            expected_uid,
+            publishers,
             subscriber,
             wake,
-            last: None,
-            expect_first: false,
+            service,
+            _node: node,
+            sequence: SequenceCheck::new(buffer),
             pending: Default::default(),
             history_size,
         })
@@ -252,26 +436,35 @@ impl AlertSubscriber {
 
     /// What the service's history hands a new subscriber, waiting `wait` for it: the alerts
     /// of this run, oldest first (the active ones among them). An empty history means the
-    /// daemon has published nothing yet, so its next alert must be number 1; a higher one
-    /// is reported as lost alerts.
-    pub fn take_history(&mut self, wait: Duration) -> Vec<Received> {
+    /// daemon has published nothing yet, so its next alert must be number 1.
+    pub fn take_history(&mut self, wait: Duration) -> Result<Vec<Received>, AlertError> {
         let end = Instant::now() + wait;
         let mut history = Vec::new();
-        while let Some(received) = self.next(end.saturating_duration_since(Instant::now())) {
+        while let Some(received) = self.next(end.saturating_duration_since(Instant::now()))? {
             history.push(received);
         }
         if history.is_empty() {
-            self.expect_first = true;
+            self.sequence.expect_first();
         }
-        history
+        Ok(history)
     }
 
-    /// The next alert (or loss, or restart), waiting at most `timeout`; `None` if nothing came.
-    pub fn next(&mut self, timeout: Duration) -> Option<Received> {
+    /// The next alert (or loss, restart, untrusted number), waiting at most `timeout`; `None`
+    /// if nothing came; an error when the service or its publisher no longer passes the check
+    /// (made again when the number of publishers changes and at each new run).
+    pub fn next(&mut self, timeout: Duration) -> Result<Option<Received>, AlertError> {
         let deadline = Instant::now() + timeout;
         loop {
             if let Some(received) = self.pending.pop_front() {
-                return Some(received);
+                if matches!(received, Received::NewRun { .. }) {
+                    self.verify()?;
+                }
+                return Ok(Some(received));
+            }
+            let publishers = self.service.dynamic_config().number_of_publishers();
+            if publishers != self.publishers {
+                self.verify()?;
+                self.publishers = publishers;
             }
             self.drain();
             if !self.pending.is_empty() {
@@ -279,7 +472,7 @@ impl AlertSubscriber {
             }
             let left = deadline.saturating_duration_since(Instant::now());
             if left.is_zero() {
-                return None;
+                return Ok(None);
             }
             // Woken by the publisher; the timed wait bounds a missed wake-up.
             let _ = self
@@ -288,34 +481,26 @@ impl AlertSubscriber {
         }
     }
 
+    fn verify(&self) -> Result<(), AlertError> {
+        let wake = self.settings.wake_name();
+        let settings = &self.settings;
+        verify_service(
+            &settings.iox,
+            &settings.service,
+            &wake,
+            &self.service,
+            self.expected_uid,
+        )
+        .map_err(|why| settings.untrusted(why))
+    }
+
+    /// Takes what arrived, one pass, and judges its sequence numbers ([`SequenceCheck`]).
     fn drain(&mut self) {
+        let mut pass = Vec::new();
         while let Ok(Some(sample)) = self.subscriber.receive() {
-            let alert = *sample.payload();
-            let expected = match self.last {
-                Some((run, seq)) if run == alert.run_id => Some(seq + 1),
-                Some(_) => {
-                    self.pending.push_back(Received::NewRun {
-                        run_id: alert.run_id,
-                    });
-                    Some(1)
-                }
-                None => self.expect_first.then_some(1),
-            };
-            if let Some(expected) = expected {
-                if alert.sequence < expected {
-                    continue; // already seen (history handed again)
-                }
-                if alert.sequence > expected {
-                    self.pending.push_back(Received::Lost {
-                        run_id: alert.run_id,
-                        first: expected,
-                        last: alert.sequence - 1,
-                    });
-                }
-            }
-            self.last = Some((alert.run_id, alert.sequence));
-            self.pending.push_back(Received::Alert(alert));
+            pass.push(*sample.payload());
         }
+        self.sequence.pass(&pass, &mut self.pending);
     }
 }
 
@@ -359,7 +544,7 @@ mod tests {
 
     fn drain(subscriber: &mut AlertSubscriber) -> Vec<Received> {
         let mut all = Vec::new();
-        while let Some(r) = subscriber.next(Duration::from_millis(300)) {
+        while let Some(r) = subscriber.next(Duration::from_millis(300)).unwrap() {
             all.push(r);
         }
         all
@@ -369,9 +554,11 @@ mod tests {
     fn a_subscriber_that_falls_behind_is_told_which_alerts_it_lost() {
         let settings = settings("lost");
         let mut publisher = AlertPublisher::start(settings.clone(), 16).unwrap();
-        let mut subscriber = AlertSubscriber::open(&settings).unwrap();
+        let mut subscriber =
+            AlertSubscriber::open(&settings, crate::fsafe::effective_uid()).unwrap();
         assert!(subscriber
             .take_history(Duration::from_millis(300))
+            .unwrap()
             .is_empty());
         let total = SUBSCRIBER_BUFFER as u64 + 44;
         for sequence in 1..=total {
@@ -408,8 +595,9 @@ mod tests {
             publisher.send(alert(sequence)).unwrap();
         }
         std::thread::sleep(Duration::from_millis(200));
-        let mut subscriber = AlertSubscriber::open(&settings).unwrap();
-        let history = subscriber.take_history(Duration::from_millis(500));
+        let mut subscriber =
+            AlertSubscriber::open(&settings, crate::fsafe::effective_uid()).unwrap();
+        let history = subscriber.take_history(Duration::from_millis(500)).unwrap();
         let sequences: Vec<u64> = history
             .iter()
             .filter_map(|r| match r {
@@ -420,7 +608,7 @@ mod tests {
         assert_eq!(sequences, (5..=20).collect::<Vec<_>>(), "{history:?}");
         publisher.send(alert(21)).unwrap();
         assert_eq!(
-            subscriber.next(Duration::from_secs(5)),
+            subscriber.next(Duration::from_secs(5)).unwrap(),
             Some(Received::Alert(alert(21)))
         );
         // The daemon restarts: a new run id, numbers from 1 again.
@@ -432,11 +620,11 @@ mod tests {
         };
         publisher.send(restarted).unwrap();
         assert_eq!(
-            subscriber.next(Duration::from_secs(5)),
+            subscriber.next(Duration::from_secs(5)).unwrap(),
             Some(Received::NewRun { run_id: 43 })
         );
         assert_eq!(
-            subscriber.next(Duration::from_secs(5)),
+            subscriber.next(Duration::from_secs(5)).unwrap(),
             Some(Received::Alert(restarted))
         );
         publisher.finish();
