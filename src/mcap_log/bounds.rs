@@ -36,30 +36,34 @@ enum Field {
     Str,
     /// u32 byte length, then key/value strings filling it exactly.
     StrMap,
-    /// u32 byte length, then that many bytes (an array or a map of integers).
+    /// u32 byte length, then that many bytes.
     Bytes32,
+    /// u32 byte length, then entries of this many bytes each (a map of integers): a length
+    /// that is not a whole number of entries would make the crate read the last entry past the
+    /// field, and every later field from the wrong place.
+    Entries32(usize),
     /// u64 byte length, then that many bytes.
     Bytes64,
 }
 
-use Field::{Bytes32, Bytes64, Fixed, Str, StrMap};
+use Field::{Bytes32, Bytes64, Entries32, Fixed, Str, StrMap};
 
 /// The length-prefixed fields of each record kind, up to the last one (what follows, such as a
 /// message's payload or a chunk's records, is not parsed by the crate's record parser). Kinds
 /// not listed are fixed-size.
 fn layout(opcode: u8) -> &'static [Field] {
     match opcode {
-        0x01 => &[Str, Str],                          // header: profile, library
-        0x03 => &[Fixed(2), Str, Str, Bytes32],       // schema
-        0x04 => &[Fixed(4), Str, Str, StrMap],        // channel
-        0x06 => &[Fixed(28), Str, Bytes64],           // chunk
-        0x07 => &[Fixed(2), Bytes32],                 // message index
-        0x08 => &[Fixed(32), Bytes32, Fixed(8), Str], // chunk index
-        0x09 => &[Fixed(16), Str, Str, Bytes64],      // attachment
-        0x0A => &[Fixed(40), Str, Str],               // attachment index
-        0x0B => &[Fixed(42), Bytes32],                // statistics
-        0x0C => &[Str, StrMap],                       // metadata
-        0x0D => &[Fixed(16), Str],                    // metadata index
+        0x01 => &[Str, Str],                                // header: profile, library
+        0x03 => &[Fixed(2), Str, Str, Bytes32],             // schema
+        0x04 => &[Fixed(4), Str, Str, StrMap],              // channel
+        0x06 => &[Fixed(28), Str, Bytes64],                 // chunk
+        0x07 => &[Fixed(2), Entries32(16)],                 // message index: (u64, u64)
+        0x08 => &[Fixed(32), Entries32(10), Fixed(8), Str], // chunk index: (u16, u64)
+        0x09 => &[Fixed(16), Str, Str, Bytes64],            // attachment
+        0x0A => &[Fixed(40), Str, Str],                     // attachment index
+        0x0B => &[Fixed(42), Entries32(10)],                // statistics: (u16, u64)
+        0x0C => &[Str, StrMap],                             // metadata
+        0x0D => &[Fixed(16), Str],                          // metadata index
         _ => &[],
     }
 }
@@ -105,6 +109,17 @@ impl Cursor<'_> {
             Str => self.prefixed(4, "string"),
             Bytes32 => self.prefixed(4, "array"),
             Bytes64 => self.prefixed(8, "data"),
+            Entries32(entry) => {
+                let len = self.length(4, "map")?;
+                if len % entry as u64 != 0 {
+                    return Err(format!(
+                        "map of {len} bytes before byte {} of the record is not a whole number of \
+                         {entry}-byte entries",
+                        self.at
+                    ));
+                }
+                self.skip(len, "map")
+            }
             StrMap => {
                 let len = self.length(4, "map")?;
                 let start = self.at;
@@ -187,6 +202,34 @@ mod tests {
             parse_record(0x04, &channel).unwrap(),
             Record::Channel(c) if c.topic == "/raw/a/x"
         ));
+    }
+
+    /// Fuzzing found it (fuzz/regressions/mcap_read/chunk-index-map-not-whole-entries.mcap):
+    /// a chunk index whose offsets map held 7 bytes made the crate read a 10-byte entry past
+    /// the map, then the compression string's length (4 GiB - 1) from the wrong bytes.
+    #[test]
+    fn a_map_of_integers_that_is_not_whole_entries_is_refused_before_the_crate_parses_it() {
+        let mut body = vec![0u8; 32];
+        body.extend(7u32.to_le_bytes());
+        body.extend([0u8; 7]);
+        body.extend(0u64.to_le_bytes());
+        body.extend(string("zstd"));
+        body.extend([0u8; 16]);
+        let err = parse_record(0x08, &body).unwrap_err();
+        assert!(
+            err.contains("not a whole number of 10-byte entries"),
+            "{err}"
+        );
+        // The same map with a whole entry parses.
+        let mut body = vec![0u8; 32];
+        body.extend(10u32.to_le_bytes());
+        body.extend([0u8; 10]);
+        body.extend(0u64.to_le_bytes());
+        body.extend(string("zstd"));
+        body.extend([0u8; 16]);
+        assert!(
+            matches!(parse_record(0x08, &body), Ok(Record::ChunkIndex(c)) if c.compression == "zstd")
+        );
     }
 
     #[test]

@@ -268,13 +268,36 @@ pub fn read_recording_with(
         return Ok(recording);
     }
     let bytes = read_file(path)?;
-    let format = detect_format(path, &bytes)?;
-    let recording = match format {
-        RecordingFormat::Matlab => mat::read(path, &bytes, selector)?,
-        RecordingFormat::PronostiaCsv => csv::read_pronostia(path, &bytes, selector)?,
-        RecordingFormat::ImsText => ims::read(path, &bytes, selector)?,
-        RecordingFormat::PlainCsv => csv::read_plain(path, &bytes, selector)?,
-        RecordingFormat::Wav => wav::read(path, &bytes, selector)?,
+    decode_recording(path, &bytes, selector, logs)
+}
+
+/// Reads one channel of a recording from bytes already in memory; `path` only names the file
+/// (its name and extension choose the format, as in [`read_recording`]). An MCAP log is
+/// refused ([`NoLogs`]). What the fuzz target `recordings` drives: the same decoders as a file,
+/// without the file system.
+pub fn read_recording_from_bytes(
+    path: &Path,
+    bytes: &[u8],
+    options: &ReadOptions,
+) -> Result<Recording, RecordingError> {
+    let selector = selector(path, options)?;
+    check_not_empty(path, bytes)?;
+    decode_recording(path, bytes, selector, &NoLogs)
+}
+
+/// The decoder [`detect_format`] picks, then the finiteness check.
+fn decode_recording(
+    path: &Path,
+    bytes: &[u8],
+    selector: Option<&str>,
+    logs: &dyn LogReader,
+) -> Result<Recording, RecordingError> {
+    let recording = match detect_format(path, bytes)? {
+        RecordingFormat::Matlab => mat::read(path, bytes, selector)?,
+        RecordingFormat::PronostiaCsv => csv::read_pronostia(path, bytes, selector)?,
+        RecordingFormat::ImsText => ims::read(path, bytes, selector)?,
+        RecordingFormat::PlainCsv => csv::read_plain(path, bytes, selector)?,
+        RecordingFormat::Wav => wav::read(path, bytes, selector)?,
         RecordingFormat::McapLog => logs.read(path, selector)?,
     };
     check_finite(&recording)?;
@@ -296,15 +319,30 @@ pub fn list_channels_with(
         return logs.channels(path);
     }
     let bytes = read_file(path)?;
-    match detect_format(path, &bytes)? {
-        RecordingFormat::Matlab => mat::channels(path, &bytes),
+    decode_channels(path, &bytes, logs)
+}
+
+/// [`list_channels`] of bytes already in memory (`path` only names them); an MCAP log is
+/// refused ([`NoLogs`]).
+pub fn list_channels_from_bytes(path: &Path, bytes: &[u8]) -> Result<Vec<String>, RecordingError> {
+    check_not_empty(path, bytes)?;
+    decode_channels(path, bytes, &NoLogs)
+}
+
+fn decode_channels(
+    path: &Path,
+    bytes: &[u8],
+    logs: &dyn LogReader,
+) -> Result<Vec<String>, RecordingError> {
+    match detect_format(path, bytes)? {
+        RecordingFormat::Matlab => mat::channels(path, bytes),
         RecordingFormat::PronostiaCsv => Ok(csv::PRONOSTIA_CHANNELS
             .iter()
             .map(|s| s.to_string())
             .collect()),
-        RecordingFormat::ImsText => ims::channels(path, &bytes),
-        RecordingFormat::PlainCsv => csv::plain_channels(path, &bytes),
-        RecordingFormat::Wav => wav::channels(path, &bytes),
+        RecordingFormat::ImsText => ims::channels(path, bytes),
+        RecordingFormat::PlainCsv => csv::plain_channels(path, bytes),
+        RecordingFormat::Wav => wav::channels(path, bytes),
         RecordingFormat::McapLog => logs.channels(path),
     }
 }
@@ -397,13 +435,18 @@ fn io_error(path: &Path, source: std::io::Error) -> RecordingError {
 /// snapshot of a file that might be growing.
 fn read_file(path: &Path) -> Result<Vec<u8>, RecordingError> {
     let bytes = std::fs::read(path).map_err(|source| io_error(path, source))?;
+    check_not_empty(path, &bytes)?;
+    Ok(bytes)
+}
+
+fn check_not_empty(path: &Path, bytes: &[u8]) -> Result<(), RecordingError> {
     if bytes.is_empty() {
         return Err(RecordingError::Empty {
             path: path.to_path_buf(),
             detail: "the file is empty (0 bytes)".to_string(),
         });
     }
-    Ok(bytes)
+    Ok(())
 }
 
 /// The one channel choice from `channel` and `column`.
@@ -484,4 +527,33 @@ fn pick_by_name_or_index(
         wanted: wanted.to_string(),
         available,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bytes_and_file_read_alike() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("table.csv");
+        let text = b"x,y\n1,2\n3,4\n5,6\n";
+        std::fs::write(&path, text).unwrap();
+        let options = ReadOptions {
+            channel: Some("y".to_string()),
+            column: None,
+        };
+        let from_file = read_recording(&path, &options).unwrap();
+        let from_bytes = read_recording_from_bytes(&path, text, &options).unwrap();
+        assert_eq!(from_bytes, from_file);
+        assert_eq!(from_bytes.samples, vec![2.0, 4.0, 6.0]);
+        assert_eq!(
+            list_channels_from_bytes(&path, text).unwrap(),
+            list_channels(&path).unwrap()
+        );
+        let empty = read_recording_from_bytes(&path, b"", &ReadOptions::default());
+        assert!(matches!(empty, Err(RecordingError::Empty { .. })));
+        let log = read_recording_from_bytes(Path::new("x.mcap"), MCAP_MAGIC, &options);
+        assert!(matches!(log, Err(RecordingError::UnknownFormat { .. })));
+    }
 }
