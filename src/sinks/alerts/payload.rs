@@ -278,6 +278,30 @@ impl AlertView {
     }
 }
 
+/// A raised outer-race alert of sensor `s` for the alert tests: `run_id` and `sequence` as
+/// given, its end sample 100 per sequence number.
+#[cfg(test)]
+pub(crate) fn test_alert(run_id: u64, sequence: u64) -> Alert {
+    Alert {
+        sequence,
+        run_id,
+        end_sample: sequence * 100,
+        wall_time_ns: 0,
+        sample_rate_hz: 12_000.0,
+        fault_frequency_hz: 107.0,
+        score: 30.0,
+        confidence: 0.9,
+        twin_error: 0.25, // not NaN: the tests compare alerts with ==
+        version: ALERT_VERSION,
+        state: AlertState::Raised as u8,
+        fault: 1,
+        severity: 1,
+        previous_severity: 0,
+        sensor: name_field("s"),
+        axis: name_field("radial"),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -117,27 +117,10 @@ impl SequenceCheck {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sinks::alerts::payload::{name_field, AlertState, ALERT_VERSION};
+    use crate::sinks::alerts::payload::test_alert;
 
     fn alert(run_id: u64, sequence: u64) -> Alert {
-        Alert {
-            sequence,
-            run_id,
-            end_sample: sequence,
-            wall_time_ns: 0,
-            sample_rate_hz: 12_000.0,
-            fault_frequency_hz: 107.0,
-            score: 30.0,
-            confidence: 0.9,
-            twin_error: 0.25,
-            version: ALERT_VERSION,
-            state: AlertState::Raised as u8,
-            fault: 1,
-            severity: 1,
-            previous_severity: 0,
-            sensor: name_field("s"),
-            axis: name_field("radial"),
-        }
+        test_alert(run_id, sequence)
     }
 
     fn judge(check: &mut SequenceCheck, alerts: &[Alert]) -> Vec<Received> {

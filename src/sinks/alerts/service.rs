@@ -507,28 +507,11 @@ impl AlertSubscriber {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sinks::alerts::payload::{name_field, AlertState, ALERT_VERSION};
+    use crate::sinks::alerts::payload::test_alert;
     use bearingd_testdata::scratch_dir;
 
     fn alert(sequence: u64) -> Alert {
-        Alert {
-            sequence,
-            run_id: 42,
-            end_sample: sequence * 100,
-            wall_time_ns: 0,
-            sample_rate_hz: 12_000.0,
-            fault_frequency_hz: 107.0,
-            score: 30.0,
-            confidence: 0.9,
-            twin_error: 0.25, // not NaN: the tests compare alerts with ==
-            version: ALERT_VERSION,
-            state: AlertState::Raised as u8,
-            fault: 1,
-            severity: 1,
-            previous_severity: 0,
-            sensor: name_field("s"),
-            axis: name_field("radial"),
-        }
+        test_alert(42, sequence)
     }
 
     fn settings(test: &str) -> AlertServiceSettings {
