@@ -109,10 +109,8 @@ fn a_root_another_user_made_first_is_refused_naming_its_owner() {
     };
     let dir = scratch_dir("hostile-root-foreign");
     let config = config(&dir, "hrf");
-    let shared = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrf");
-    let _ = std::fs::remove_dir_all(&shared);
-    std::fs::create_dir_all(&shared).unwrap();
-    std::fs::set_permissions(&shared, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    let configured = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrf");
+    let shared = sticky_dir_of_two_users("hrf");
     let root = shared.join("r");
     let made = as_user(other, "mkdir")
         .args(["-m", "0777"])
@@ -125,7 +123,7 @@ fn a_root_another_user_made_first_is_refused_naming_its_owner() {
         root.display()
     );
     let text = std::fs::read_to_string(&config).unwrap().replace(
-        &format!("\"{}\"", shared.display()),
+        &format!("\"{}\"", configured.display()),
         &format!("\"{}\"", root.display()),
     );
     std::fs::write(&config, text).unwrap();
@@ -145,6 +143,17 @@ fn a_root_another_user_made_first_is_refused_naming_its_owner() {
         "iceoryx2 used it"
     );
     std::fs::remove_dir_all(&shared).unwrap();
+}
+
+/// A fresh directory directly in /dev/shm, mode 1777 as /dev/shm itself: both users may make
+/// entries in it (the tests' own iox roots may sit in a 0700 directory of the test's user,
+/// which the other user cannot enter).
+fn sticky_dir_of_two_users(tag: &str) -> PathBuf {
+    let dir = PathBuf::from(format!("/dev/shm/bd-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir(&dir).unwrap();
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    dir
 }
 
 /// The uid to act as another user (`$BEARINGD_TEST_OTHER_UID`, default 61032, no passwd
@@ -340,10 +349,8 @@ fn roots_subscribers_refuse_another_users_root_and_never_switch_to_it() {
     };
     let dir = scratch_dir("hostile-root-sub");
     let config = config(&dir, "hrs");
-    let shared = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrs");
-    let _ = std::fs::remove_dir_all(&shared);
-    std::fs::create_dir_all(&shared).unwrap();
-    std::fs::set_permissions(&shared, std::fs::Permissions::from_mode(0o1777)).unwrap();
+    let configured = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrs");
+    let shared = sticky_dir_of_two_users("hrs");
     let root: PathBuf = shared.join("r");
     let made = as_user(other, "mkdir")
         .args(["-m", "0700"])
@@ -352,7 +359,7 @@ fn roots_subscribers_refuse_another_users_root_and_never_switch_to_it() {
         .unwrap();
     assert!(made.success());
     let text = std::fs::read_to_string(&config).unwrap().replace(
-        &format!("\"{}\"", shared.display()),
+        &format!("\"{}\"", configured.display()),
         &format!("\"{}\"", root.display()),
     );
     std::fs::write(&config, text).unwrap();
