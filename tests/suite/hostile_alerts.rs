@@ -108,25 +108,7 @@ fn a_root_another_user_made_first_is_refused_naming_its_owner() {
         return;
     };
     let dir = scratch_dir("hostile-root-foreign");
-    let config = config(&dir, "hrf");
-    let configured = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrf");
-    let shared = sticky_dir_of_two_users("hrf");
-    let root = shared.join("r");
-    let made = as_user(other, "mkdir")
-        .args(["-m", "0777"])
-        .arg(&root)
-        .status()
-        .expect("run setpriv (util-linux)");
-    assert!(
-        made.success(),
-        "uid {other} could not create {}",
-        root.display()
-    );
-    let text = std::fs::read_to_string(&config).unwrap().replace(
-        &format!("\"{}\"", configured.display()),
-        &format!("\"{}\"", root.display()),
-    );
-    std::fs::write(&config, text).unwrap();
+    let (config, shared, root) = root_made_by(other, "0777", &dir, "hrf");
     let root_text = root.display().to_string();
     refused_twice(
         &config,
@@ -143,6 +125,31 @@ fn a_root_another_user_made_first_is_refused_naming_its_owner() {
         "iceoryx2 used it"
     );
     std::fs::remove_dir_all(&shared).unwrap();
+}
+
+/// A config in `dir` whose iceoryx2 root `<shared>/r` user `other` made first, with `mode`
+/// (`mkdir -m`); returns (config, shared, root).
+fn root_made_by(other: u32, mode: &str, dir: &Path, tag: &str) -> (PathBuf, PathBuf, PathBuf) {
+    let config = config(dir, tag);
+    let configured = iox_root(env!("CARGO_TARGET_TMPDIR"), tag);
+    let shared = sticky_dir_of_two_users(tag);
+    let root = shared.join("r");
+    let made = as_user(other, "mkdir")
+        .args(["-m", mode])
+        .arg(&root)
+        .status()
+        .expect("run setpriv (util-linux)");
+    assert!(
+        made.success(),
+        "uid {other} could not create {}",
+        root.display()
+    );
+    let text = std::fs::read_to_string(&config).unwrap().replace(
+        &format!("\"{}\"", configured.display()),
+        &format!("\"{}\"", root.display()),
+    );
+    std::fs::write(&config, text).unwrap();
+    (config, shared, root)
 }
 
 /// A fresh directory directly in /dev/shm, mode 1777 as /dev/shm itself: both users may make
@@ -348,21 +355,7 @@ fn roots_subscribers_refuse_another_users_root_and_never_switch_to_it() {
         return;
     };
     let dir = scratch_dir("hostile-root-sub");
-    let config = config(&dir, "hrs");
-    let configured = iox_root(env!("CARGO_TARGET_TMPDIR"), "hrs");
-    let shared = sticky_dir_of_two_users("hrs");
-    let root: PathBuf = shared.join("r");
-    let made = as_user(other, "mkdir")
-        .args(["-m", "0700"])
-        .arg(&root)
-        .status()
-        .unwrap();
-    assert!(made.success());
-    let text = std::fs::read_to_string(&config).unwrap().replace(
-        &format!("\"{}\"", configured.display()),
-        &format!("\"{}\"", root.display()),
-    );
-    std::fs::write(&config, text).unwrap();
+    let (config, shared, root) = root_made_by(other, "0700", &dir, "hrs");
     let out = alerts_json(&config, "3");
     let err = stderr_of(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
