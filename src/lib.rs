@@ -5,7 +5,8 @@
 //! The rooms, top to bottom: a room uses only rooms listed below it, never one above
 //! (`scripts/module_deps.py` checks this in CI, and that there is no import cycle).
 //!
-//! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or uses `anyhow`.
+//! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or turns typed errors
+//!   into messages for people.
 //! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
 //!   SNR, speed and bearing through the real pipeline, and recordings of a manifest through
 //!   `analyze` and through the daemon's replay (`bearingd evaluate`). Above [`daemon`]: it

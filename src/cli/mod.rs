@@ -1,6 +1,6 @@
 //! The `bearingd` command line. The only place that prints, chooses exit codes, or turns
-//! typed errors into messages for people (DESIGN.md "Errors": `anyhow`-style handling lives
-//! only at this edge).
+//! typed errors into messages for people (DESIGN.md "Errors": that handling lives only at this
+//! edge; the library returns typed errors).
 //!
 //! Exit codes: 0 success, 2 bad input (a file, an option or a config that cannot be used; the
 //! message names it and says how to fix it), 1 anything else.
@@ -21,6 +21,7 @@ mod run;
 mod simulate;
 mod train;
 mod trend;
+mod twin_args;
 
 use clap::{Args, Parser, Subcommand};
 use std::process::ExitCode;
