@@ -90,7 +90,8 @@ fn rolling_envelope_and_scoring_never_allocate_per_hop() {
 #[test]
 fn a_monitor_takes_hops_and_speed_changes_without_allocating() {
     use bearingd::analysis::flags::FlagSettings;
-    use bearingd::analysis::monitor::{ChannelMonitor, MonitorSettings, SpeedMode};
+    use bearingd::analysis::monitor::{ChannelMonitor, MonitorSettings};
+    use bearingd::analysis::speed::SpeedMode;
     use bearingd::analysis::AnalysisSettings;
     use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 

@@ -1,5 +1,7 @@
-//! Frequency bands and the arithmetic that maps them onto FFT bins.
+//! Frequency bands, the arithmetic that maps them onto FFT bins, and how wide a band the fault
+//! combs need.
 
+use crate::bearing::FaultFrequencies;
 use serde::Serialize;
 
 /// A frequency band `[lo_hz, hi_hz)`.
@@ -37,4 +39,21 @@ impl std::fmt::Display for Band {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{:.0}–{:.0} Hz", self.lo_hz, self.hi_hz)
     }
+}
+
+/// The highest envelope frequency the scores need: the last harmonic of the highest fault
+/// frequency, its upper sideband, and the noise neighbourhood beyond it.
+pub fn envelope_range_hz(freqs: &FaultFrequencies, harmonics: usize) -> f64 {
+    comb_width_hz(freqs, harmonics) + 0.5 * top_fault_hz(freqs)
+}
+
+/// The highest fault frequency with a comb worth scoring.
+fn top_fault_hz(freqs: &FaultFrequencies) -> f64 {
+    freqs.bpfo.max(freqs.bpfi).max(freqs.two_bsf)
+}
+
+/// The envelope bandwidth the combs need: the highest fault frequency's last harmonic and its
+/// upper sideband. A demodulation band narrower than this cannot hold them.
+pub fn comb_width_hz(freqs: &FaultFrequencies, harmonics: usize) -> f64 {
+    harmonics as f64 * top_fault_hz(freqs) + freqs.shaft.max(freqs.ftf)
 }

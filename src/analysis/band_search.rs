@@ -24,8 +24,8 @@
 //!   decades at the false-alarm rates the decision uses. A unit test re-measures the search's
 //!   false-alarm rate on noise records on every CI run.
 
+use super::band::comb_width_hz;
 use super::kurtogram::BandScan;
-use super::record::comb_width_hz;
 use super::settings::{AnalysisSettings, BandSelection};
 use crate::bearing::FaultFrequencies;
 

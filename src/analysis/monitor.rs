@@ -47,6 +47,7 @@
 //! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
 
 use super::agreement::Witness;
+use super::band::envelope_range_hz;
 use super::band_selection::Evidence;
 use super::band_selection::{
     scaled, usable_shaft_hz, BandJob, BandResult, BandSelector, InlineSelector,
@@ -58,8 +59,7 @@ use super::flags::{FaultFlag, FlagChange, FlagSettings};
 use super::health::{Baseline, HealthTracker, StageChange, CONFIRM_WINDOWS};
 use super::indicators::Indicators;
 use super::iso::{SeveritySettings, VelocityReading, VelocityTracker, ZoneLimits};
-use super::record::envelope_range_hz;
-use super::speed::SpeedSearch;
+use super::speed::SpeedMode;
 use super::{AnalysisSettings, Band};
 use crate::bearing::FaultFrequencies;
 use crate::messages::{FaultKind, FlagLevel, HealthKind, HealthStage};
@@ -115,33 +115,6 @@ impl Default for TrendSettings {
             point_s: 60.0,
             points: 30,
             confidence: 0.9,
-        }
-    }
-}
-
-/// Where a channel's shaft speed comes from.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum SpeedMode {
-    /// The speed given to [`ChannelMonitor::new`], for good.
-    Fixed,
-    /// Given from outside with [`ChannelMonitor::set_speed_at`]: `known_at_start` says whether
-    /// the speed given to `new` may be used until then (a nominal speed) or the channel waits.
-    /// Speeds above `max_shaft_hz` (the envelope spectrum is sized for it) are not usable.
-    Given {
-        known_at_start: bool,
-        max_shaft_hz: f64,
-    },
-    /// Estimated from the history at every band selection, within the search.
-    Estimate(SpeedSearch),
-}
-
-impl SpeedMode {
-    /// The highest shaft rate the channel analyses, given the starting one.
-    pub(crate) fn max_shaft_hz(&self, start_hz: f64) -> f64 {
-        match *self {
-            SpeedMode::Fixed => start_hz,
-            SpeedMode::Given { max_shaft_hz, .. } => max_shaft_hz.max(start_hz),
-            SpeedMode::Estimate(search) => search.nominal_hz * (1.0 + search.range),
         }
     }
 }

@@ -7,7 +7,7 @@
 //! thereby only add evidence, never cut it away.
 
 use super::agreement::{decide, WitnessOpinion};
-use super::band::Band;
+use super::band::{comb_width_hz, envelope_range_hz, Band};
 use super::band_search::{candidate_bands, search_significance};
 use super::diagnosis::{diagnose, leader, Diagnosis};
 use super::envelope::{window_samples, EnvelopeSpectrum, FftPlans};
@@ -132,23 +132,6 @@ fn reported_band(hypotheses: &[Hypothesis], diagnosis: &Diagnosis, selected: usi
         .fault()
         .and_then(|kind| hypotheses.iter().find(|h| h.score.fault == kind))
         .map_or(selected, |h| h.band_index)
-}
-
-/// The highest envelope frequency the scores need: the last harmonic of the highest fault
-/// frequency, its upper sideband, and the noise neighbourhood beyond it.
-pub fn envelope_range_hz(freqs: &FaultFrequencies, harmonics: usize) -> f64 {
-    comb_width_hz(freqs, harmonics) + 0.5 * top_fault_hz(freqs)
-}
-
-/// The highest fault frequency with a comb worth scoring.
-fn top_fault_hz(freqs: &FaultFrequencies) -> f64 {
-    freqs.bpfo.max(freqs.bpfi).max(freqs.two_bsf)
-}
-
-/// The envelope bandwidth the combs need: the highest fault frequency's last harmonic and its
-/// upper sideband. A demodulation band narrower than this cannot hold them.
-pub fn comb_width_hz(freqs: &FaultFrequencies, harmonics: usize) -> f64 {
-    harmonics as f64 * top_fault_hz(freqs) + freqs.shaft.max(freqs.ftf)
 }
 
 /// Analyses whole records; keeps FFT plans between records so that only the first pays for

@@ -44,6 +44,34 @@ pub struct SpeedSearch {
     pub range: f64,
 }
 
+/// Where a channel's shaft speed comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SpeedMode {
+    /// The speed the channel's monitor was made with, for good.
+    Fixed,
+    /// Given from outside at a sample position (the monitor's `set_speed_at`): `known_at_start`
+    /// says whether the speed the monitor was made with may be used until then (a nominal
+    /// speed) or the channel waits.
+    /// Speeds above `max_shaft_hz` (the envelope spectrum is sized for it) are not usable.
+    Given {
+        known_at_start: bool,
+        max_shaft_hz: f64,
+    },
+    /// Estimated from the history at every band selection, within the search.
+    Estimate(SpeedSearch),
+}
+
+impl SpeedMode {
+    /// The highest shaft rate the channel analyses, given the starting one.
+    pub(crate) fn max_shaft_hz(&self, start_hz: f64) -> f64 {
+        match *self {
+            SpeedMode::Fixed => start_hz,
+            SpeedMode::Given { max_shaft_hz, .. } => max_shaft_hz.max(start_hz),
+            SpeedMode::Estimate(search) => search.nominal_hz * (1.0 + search.range),
+        }
+    }
+}
+
 /// An estimated shaft rate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpeedEstimate {

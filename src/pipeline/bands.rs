@@ -81,7 +81,7 @@ impl BandSelector for WorkerSelector {
 mod tests {
     use super::*;
     use crate::analysis::band_selection::InlineSelector;
-    use crate::analysis::monitor::SpeedMode;
+    use crate::analysis::speed::SpeedMode;
     use crate::analysis::AnalysisSettings;
     use crate::twin::{SimulatedFault, SimulationParams, Simulator};
 

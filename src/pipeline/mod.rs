@@ -25,10 +25,8 @@ pub use sink::{Sink, SinkError};
 use crate::analysis::agreement::Witness;
 use crate::analysis::flags::FlagSettings;
 use crate::analysis::health::Baseline;
-use crate::analysis::monitor::{
-    ChannelMonitor, MonitorEvent, MonitorSettings, SpeedMode, TrendSettings,
-};
-use crate::analysis::speed::SpeedSearch;
+use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings, TrendSettings};
+use crate::analysis::speed::{SpeedMode, SpeedSearch};
 use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
 use crate::config::{Config, SensorConfig, Speed};

@@ -3,7 +3,8 @@
 //! exactly the same events at the same samples.
 
 use bearingd::analysis::flags::FlagSettings;
-use bearingd::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings, SpeedMode};
+use bearingd::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
+use bearingd::analysis::speed::SpeedMode;
 use bearingd::analysis::AnalysisSettings;
 use bearingd::messages::{FlagLevel, HealthKind, HealthStage};
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
