@@ -3,7 +3,7 @@
 //! as a picture of the measured and simulated spectra, and save the calibrated parameters for
 //! `bearingd simulate --model physics --calibrated FILE`.
 
-use super::simulate::FaultArg;
+use super::twin_args::{DofArg, FaultArg};
 use super::{CliError, RecordingArgs};
 use crate::analysis::band::Band;
 use crate::analysis::record::analyze_record;
@@ -14,26 +14,9 @@ use crate::plot::{self, Color, Figure, Series, Shade, SpectrumPanel};
 use crate::recording::read_recording;
 use crate::twin::physics::{calibrate, Calibration, CalibrationSettings, Dof, PhysicsParams};
 use crate::twin::SimulatedFault;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;
-
-#[derive(Clone, Copy, ValueEnum)]
-pub enum DofArg {
-    /// Seed 001: shaft, housing and a resonator, each in x and y.
-    Six,
-    /// Seed 003: the resonator in y only.
-    Five,
-}
-
-impl From<DofArg> for Dof {
-    fn from(dof: DofArg) -> Self {
-        match dof {
-            DofArg::Six => Dof::Six,
-            DofArg::Five => Dof::Five,
-        }
-    }
-}
 
 #[derive(Args)]
 pub struct CalibrateArgs {

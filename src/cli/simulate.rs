@@ -3,35 +3,14 @@
 //! ringing a resonance, MODELS.md §4) or from the physics twin (the 6-DOF contact model,
 //! MODELS.md §5, optionally with parameters calibrated to a real machine).
 
-use super::calibrate::DofArg;
+use super::twin_args::{DofArg, FaultArg};
 use super::CliError;
 use crate::bearing::BearingGeometry;
 use crate::twin::physics::{PhysicsModel, PhysicsParams};
-use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
+use crate::twin::{Nuisance, SimulationParams, Simulator};
 use clap::{Args, ValueEnum};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
-
-#[derive(Clone, Copy, ValueEnum)]
-pub enum FaultArg {
-    None,
-    Outer,
-    Inner,
-    Ball,
-    Cage,
-}
-
-impl From<FaultArg> for SimulatedFault {
-    fn from(fault: FaultArg) -> Self {
-        match fault {
-            FaultArg::None => SimulatedFault::None,
-            FaultArg::Outer => SimulatedFault::OuterRace,
-            FaultArg::Inner => SimulatedFault::InnerRace,
-            FaultArg::Ball => SimulatedFault::Ball,
-            FaultArg::Cage => SimulatedFault::Cage,
-        }
-    }
-}
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ModelArg {
