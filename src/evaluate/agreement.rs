@@ -9,7 +9,7 @@
 //! confirmed by real runs of both paths (docs/DIAGNOSIS.md, "Agreement with the learned
 //! model").
 
-use super::run::{CaseResult, Predicted};
+use super::outcome::{CaseResult, Predicted};
 use super::summary::is_confident_wrong;
 use crate::analysis::agreement::{decide, Agreement, WitnessOpinion};
 use crate::analysis::record::RecordAnalysis;

@@ -28,13 +28,15 @@
 pub mod agreement;
 pub mod false_alarms;
 pub mod figure;
+pub mod outcome;
 pub mod recordings;
 pub mod run;
 pub mod summary;
 pub mod sweep;
 
 pub use figure::pd_figure;
-pub use run::{run_case, Bench, CaseResult, Predicted};
+pub use outcome::{CaseResult, Predicted};
+pub use run::{run_case, Bench};
 pub use summary::{render_csv, render_tables, summarize, Path, Summary};
 pub use sweep::{Case, Machine, NoiseLevel, Sweep};
 

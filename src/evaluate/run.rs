@@ -7,12 +7,13 @@
 //!   as the sensor's integer counts in blocks with their sample positions, in sample time.
 
 use super::agreement::grid_verdicts;
+use super::outcome::{CaseResult, MonitorOutcome, Predicted, RecordOutcome};
 use super::sweep::{Case, Machine, NoiseLevel, Sweep, DEFAULT_SEVERITY};
-use crate::analysis::agreement::{Witness, WitnessOpinion};
+use crate::analysis::agreement::Witness;
 use crate::analysis::diagnosis::DecisionRule;
 use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
 use crate::analysis::record::RecordAnalyzer;
-use crate::analysis::{AnalysisSettings, Diagnosis, Verdict};
+use crate::analysis::{AnalysisSettings, Diagnosis};
 use crate::config::{Config, SensorConfig, SimConfig, Speed, Transport};
 use crate::learned::ModelError;
 use crate::messages::FaultKind;
@@ -21,162 +22,6 @@ use crate::pipeline::{load_learned, monitor_settings};
 use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
 use serde::Serialize;
 use std::sync::Arc;
-
-/// What one path concluded about one record.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Predicted {
-    None,
-    Fault(FaultKind),
-    /// The record path declined to pick between named hypotheses (a verdict that is neither
-    /// `none` nor one fault).
-    Ambiguous,
-    /// The monitor raised the flags of more than one fault kind.
-    Several,
-}
-
-impl Predicted {
-    pub fn name(self) -> &'static str {
-        match self {
-            Predicted::None => "none",
-            Predicted::Fault(kind) => kind.name(),
-            Predicted::Ambiguous => "ambiguous",
-            Predicted::Several => "several",
-        }
-    }
-
-    /// The columns of a confusion matrix, in order.
-    pub const COLUMNS: [Predicted; 7] = [
-        Predicted::None,
-        Predicted::Fault(FaultKind::OuterRace),
-        Predicted::Fault(FaultKind::InnerRace),
-        Predicted::Fault(FaultKind::Ball),
-        Predicted::Fault(FaultKind::Cage),
-        Predicted::Ambiguous,
-        Predicted::Several,
-    ];
-
-    /// What the flags say, from the highest level each fault's flag reached (outer, inner,
-    /// ball, cage): the one fault whose flag rose, none, the two of a verdict that cannot tell
-    /// them apart (a rolling element or the cage: ambiguous, as that verdict), or several.
-    pub fn of_flags(highest: [FlagLevel; 4]) -> Self {
-        let raised: Vec<FaultKind> = FaultKind::ALL
-            .into_iter()
-            .zip(highest)
-            .filter(|(_, level)| *level > FlagLevel::Ok)
-            .map(|(kind, _)| kind)
-            .collect();
-        match raised.as_slice() {
-            [] => Predicted::None,
-            [kind] => Predicted::Fault(*kind),
-            both if both == Verdict::BallOrCage.faults() => Predicted::Ambiguous,
-            _ => Predicted::Several,
-        }
-    }
-
-    /// What a verdict says. Written against the verdict's public meaning (`fault()` names one
-    /// fault or none), so that a verdict added later for "both named, not separable" counts as
-    /// ambiguous without a change here.
-    pub fn of_verdict(verdict: Verdict) -> Self {
-        match verdict.fault() {
-            Some(kind) => Predicted::Fault(kind),
-            None if verdict == Verdict::None => Predicted::None,
-            None => Predicted::Ambiguous,
-        }
-    }
-}
-
-/// The record path's outcome.
-#[derive(Debug, Clone, Serialize)]
-pub struct RecordOutcome {
-    pub verdict: String,
-    pub predicted: Predicted,
-    pub confidence: f64,
-    pub reason: String,
-    /// With a `none` verdict: the faults detected but not told apart.
-    pub candidates: Vec<FaultKind>,
-    /// Fault scores in outer, inner, ball, cage order.
-    pub scores: [f64; 4],
-    /// The learned model's opinion, when the bench has a model that knows the bearing.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub learned: Option<WitnessOpinion>,
-    /// With a model: the verdict at each point of [`super::agreement::grid`].
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub agreement_grid: Vec<Predicted>,
-}
-
-/// The monitor path's outcome.
-#[derive(Debug, Clone, Serialize)]
-pub struct MonitorOutcome {
-    /// The highest level each fault's flag reached (outer, inner, ball, cage).
-    pub highest: [FlagLevel; 4],
-    /// When the first flag rose, s of sample time.
-    pub first_flag_s: Option<f64>,
-    /// Windows scored after the first band selection, and how many of them had a flag up.
-    pub windows_scored: u64,
-    pub windows_flagged: u64,
-    pub predicted: Predicted,
-}
-
-/// One case's results.
-#[derive(Debug, Clone, Serialize)]
-pub struct CaseResult {
-    pub case: Case,
-    /// RMS of the broadband noise (white and shaft-modulated), g.
-    pub noise_g: f64,
-    /// The fault's RMS over the broadband noise's, dB (`None` for healthy records).
-    pub snr_db: Option<f64>,
-    /// `Err`: the record could not be analysed (the message says why); counts as a miss.
-    pub record: Result<RecordOutcome, String>,
-    pub monitor: MonitorOutcome,
-}
-
-impl CaseResult {
-    pub fn truth(&self) -> Option<FaultKind> {
-        self.case.fault.kind()
-    }
-
-    /// One line saying what was simulated and what both paths made of it (for test failures
-    /// and logs).
-    pub fn describe(&self) -> String {
-        let record = match &self.record {
-            Ok(o) => format!(
-                "analyze: {} ({:.2}; scores outer {:.1} inner {:.1} ball {:.1} cage {:.1}; {})",
-                o.verdict,
-                o.confidence,
-                o.scores[0],
-                o.scores[1],
-                o.scores[2],
-                o.scores[3],
-                o.reason
-            ),
-            Err(e) => format!("analyze failed: {e}"),
-        };
-        let flags: Vec<String> = FaultKind::ALL
-            .iter()
-            .zip(self.monitor.highest)
-            .map(|(k, l)| format!("{} {}", k.name(), l.name()))
-            .collect();
-        format!(
-            "{} on {} at {:.0} rpm, severity {} g, noise {} ({:.3} g{}): {record}; monitor flags: {}",
-            self.case.fault.name(),
-            self.case.bearing,
-            self.case.rpm,
-            self.case.severity,
-            self.case.noise.label(),
-            self.noise_g,
-            self.snr_db
-                .map_or(String::new(), |s| format!(", SNR {s:+.1} dB")),
-            flags.join(", ")
-        )
-    }
-
-    pub fn record_predicted(&self) -> Predicted {
-        self.record
-            .as_ref()
-            .map_or(Predicted::None, |outcome| outcome.predicted)
-    }
-}
 
 /// What every case of a sweep shares: the daemon's settings, and the learned model its
 /// verdicts hear (`twin.learned_model`, with `analysis.agreement_*`).

@@ -2,7 +2,7 @@
 //! probability per fault and noise level, false alarms on healthy records (per record, and per
 //! window for the monitor), the confusion matrix and the confident-wrong count, for each path.
 
-use super::run::{CaseResult, Predicted};
+use super::outcome::{CaseResult, Predicted};
 use super::sweep::{NoiseLevel, DEFAULT_SEVERITY};
 use crate::messages::FaultKind;
 use crate::twin::SimulatedFault;

@@ -7,11 +7,12 @@
 //! still being changed (docs/DIAGNOSIS.md "Recordings").
 
 use bearingd::analysis::agreement::Agreement;
+use bearingd::evaluate::outcome::Predicted;
 use bearingd::evaluate::recordings::{
     evaluate_recordings, plan, render_recordings, tally, DaemonOutcome, Entry, Manifest,
     RecordingsAgreement, RecordingsOptions, RecordingsReport, Truth,
 };
-use bearingd::evaluate::run::{CaseSignal, Predicted};
+use bearingd::evaluate::run::CaseSignal;
 use bearingd::evaluate::{NoiseLevel, Sweep};
 use bearingd::learned::LearnedModel;
 use bearingd::messages::FaultKind;
@@ -259,7 +260,7 @@ fn a_two_and_a_half_second_record_that_analyze_names_is_flagged_by_the_daemon() 
         };
         assert_eq!(
             record.predicted,
-            bearingd::evaluate::run::Predicted::Fault(fault),
+            bearingd::evaluate::outcome::Predicted::Fault(fault),
             "{label}: analyze on 2.5 s"
         );
         let DaemonOutcome::Judged { monitor, flags, .. } = &e.daemon else {

@@ -35,7 +35,8 @@ pub mod tally;
 pub use manifest::{Manifest, ManifestError, ManifestRecord, Truth};
 pub use tally::{render_recordings, tally, Said, Tally};
 
-use super::run::{record_outcome, MonitorOutcome, Predicted, RecordOutcome};
+use super::outcome::{MonitorOutcome, Predicted, RecordOutcome};
+use super::run::record_outcome;
 use crate::analysis::agreement::{Agreement, Witness};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::AnalysisSettings;

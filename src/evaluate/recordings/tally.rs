@@ -4,7 +4,7 @@
 //! only from the entries, so the JSON's entries and its summary cannot disagree.
 
 use super::{DaemonOutcome, Entry, FlagChange, Truth};
-use crate::evaluate::run::Predicted;
+use crate::evaluate::outcome::Predicted;
 use crate::evaluate::summary::{is_confident_wrong, render_confusion, Path};
 use crate::messages::FaultKind;
 use serde::Serialize;
@@ -342,8 +342,8 @@ pub fn render_recordings(tally: &Tally) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::evaluate::outcome::{MonitorOutcome, RecordOutcome};
     use crate::evaluate::recordings::{agreement, agrees};
-    use crate::evaluate::run::{MonitorOutcome, RecordOutcome};
     use crate::messages::FlagLevel;
     use std::path::PathBuf;
 
