@@ -13,10 +13,10 @@ use core::fmt;
 use heapless::Vec;
 
 use crate::frame::{
-    AxisSet, DataFrame, DevicePage, FirmwareVersion, Frame, FrameKind, Metadata, MetadataPage,
-    SpeedFrame, SpeedSource, StreamPage, PROTOCOL_VERSION, SAMPLES_CAPACITY, SPEED_NOT_AVAILABLE,
+    AxisSet, DataFrame, DevicePage, FirmwareVersion, Frame, Metadata, MetadataPage, SpeedFrame,
+    SpeedSource, StreamPage, PROTOCOL_VERSION, SAMPLES_CAPACITY, SPEED_NOT_AVAILABLE,
 };
-use crate::id::{CanId, MessageKind, AXIS_COUNT, NODE_COUNT};
+use crate::id::{CanId, FrameKind, MessageKind, AXIS_COUNT, NODE_COUNT};
 
 /// Length of an FD data frame (CAN FD DLC 15).
 pub const FD_DATA_LEN: usize = 64;

@@ -7,7 +7,7 @@
 
 use heapless::Vec;
 
-use crate::id::AXIS_COUNT;
+use crate::id::{FrameKind, AXIS_COUNT};
 
 /// Version of the wire protocol described here, sent in the high nibble of byte 0 of every
 /// metadata page (so `1..=15`). A receiver refuses metadata of any other version rather than
@@ -17,58 +17,6 @@ pub const PROTOCOL_VERSION: u8 = 1;
 /// Capacity of [`DataFrame::samples`]. Bigger than any layout carries (see
 /// [`FrameKind::max_samples`]) so that one type serves both.
 pub const SAMPLES_CAPACITY: usize = 31;
-
-/// Which data-frame layout a node sends.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum FrameKind {
-    /// Classic CAN: 8 bytes, 2 samples, 8-bit sequence, 24-bit sample index.
-    Classic,
-    /// CAN FD: 64 bytes, up to 28 samples, 16-bit sequence, 32-bit sample index.
-    Fd,
-}
-
-impl FrameKind {
-    /// Most samples one data frame of this layout carries.
-    pub const fn max_samples(self) -> usize {
-        match self {
-            FrameKind::Classic => 2,
-            FrameKind::Fd => 28,
-        }
-    }
-
-    /// Bits of the sequence counter that travel on the wire.
-    pub const fn sequence_bits(self) -> u32 {
-        match self {
-            FrameKind::Classic => 8,
-            FrameKind::Fd => 16,
-        }
-    }
-
-    /// Bits of the first-sample index that travel on the wire.
-    pub const fn index_bits(self) -> u32 {
-        match self {
-            FrameKind::Classic => 24,
-            FrameKind::Fd => 32,
-        }
-    }
-
-    /// The value of the metadata `data_kind` byte.
-    pub const fn code(self) -> u8 {
-        match self {
-            FrameKind::Classic => 0,
-            FrameKind::Fd => 1,
-        }
-    }
-
-    /// Inverse of [`FrameKind::code`].
-    pub const fn from_code(code: u8) -> Option<FrameKind> {
-        match code {
-            0 => Some(FrameKind::Classic),
-            1 => Some(FrameKind::Fd),
-            _ => None,
-        }
-    }
-}
 
 /// A set of axis ids (bit `a` set means axis `a` is streamed). Only the low
 /// [`AXIS_COUNT`] bits may be set.

@@ -16,12 +16,62 @@
 //! node's transmit queue is finite and the stream never pauses) beat speed frames, which beat
 //! metadata. `0x190..=0x1EF` is left free for future kinds of middle priority.
 
-use crate::frame::FrameKind;
-
 /// Number of sensor nodes that can share one bus: node ids are `0..NODE_COUNT`.
 pub const NODE_COUNT: u8 = 16;
 /// Number of axes a node can stream: axis ids are `0..AXIS_COUNT`.
 pub const AXIS_COUNT: u8 = 4;
+
+/// Which data-frame layout a node sends.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FrameKind {
+    /// Classic CAN: 8 bytes, 2 samples, 8-bit sequence, 24-bit sample index.
+    Classic,
+    /// CAN FD: 64 bytes, up to 28 samples, 16-bit sequence, 32-bit sample index.
+    Fd,
+}
+
+impl FrameKind {
+    /// Most samples one data frame of this layout carries.
+    pub const fn max_samples(self) -> usize {
+        match self {
+            FrameKind::Classic => 2,
+            FrameKind::Fd => 28,
+        }
+    }
+
+    /// Bits of the sequence counter that travel on the wire.
+    pub const fn sequence_bits(self) -> u32 {
+        match self {
+            FrameKind::Classic => 8,
+            FrameKind::Fd => 16,
+        }
+    }
+
+    /// Bits of the first-sample index that travel on the wire.
+    pub const fn index_bits(self) -> u32 {
+        match self {
+            FrameKind::Classic => 24,
+            FrameKind::Fd => 32,
+        }
+    }
+
+    /// The value of the metadata `data_kind` byte.
+    pub const fn code(self) -> u8 {
+        match self {
+            FrameKind::Classic => 0,
+            FrameKind::Fd => 1,
+        }
+    }
+
+    /// Inverse of [`FrameKind::code`].
+    pub const fn from_code(code: u8) -> Option<FrameKind> {
+        match code {
+            0 => Some(FrameKind::Classic),
+            1 => Some(FrameKind::Fd),
+            _ => None,
+        }
+    }
+}
 
 /// First identifier of CAN FD data frames.
 pub const DATA_FD_BASE: u16 = 0x100;

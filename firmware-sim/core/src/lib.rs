@@ -65,14 +65,17 @@
 //!
 //! # Layout
 //!
-//! - [`id`]: the 11-bit CAN identifier plan (which id carries which frame, and why in that
-//!   priority order).
-//! - [`frame`]: the decoded frames ([`Frame`], [`DataFrame`], [`Metadata`], [`SpeedFrame`]) and
-//!   the receiver's [`MetadataAssembler`].
-//! - [`codec`]: [`encode`] and [`decode`], with [`EncodeError`] and [`DecodeError`].
+//! Top to bottom; a module uses only modules listed below it (`scripts/module_deps.py` checks
+//! this in CI, and that there is no import cycle).
+//!
+//! - [`tracker`]: [`SequenceTracker`], the receiver's per-(node, axis) loss and restart detector.
 //! - [`node`]: [`SensorNode`], the sampling state machine of a node: samples in, frames out,
 //!   through a bounded queue whose overflow is counted.
-//! - [`tracker`]: [`SequenceTracker`], the receiver's per-(node, axis) loss and restart detector.
+//! - [`codec`]: [`encode`] and [`decode`], with [`EncodeError`] and [`DecodeError`].
+//! - [`frame`]: the decoded frames ([`Frame`], [`DataFrame`], [`Metadata`], [`SpeedFrame`]) and
+//!   the receiver's [`MetadataAssembler`].
+//! - [`id`]: the 11-bit CAN identifier plan (which id carries which frame, and why in that
+//!   priority order).
 
 pub mod codec;
 pub mod frame;
@@ -82,9 +85,9 @@ pub mod tracker;
 
 pub use codec::{decode, encode, DecodeError, EncodeError};
 pub use frame::{
-    AxisSet, DataFrame, DevicePage, FirmwareVersion, Frame, FrameKind, Metadata, MetadataAssembler,
+    AxisSet, DataFrame, DevicePage, FirmwareVersion, Frame, Metadata, MetadataAssembler,
     MetadataPage, NodeInfo, SpeedFrame, SpeedSource, StreamPage, PROTOCOL_VERSION,
 };
-pub use id::{CanId, MessageKind};
+pub use id::{CanId, FrameKind, MessageKind};
 pub use node::{ConfigError, NodeConfig, NodeStats, PushError, Pushed, SensorNode};
 pub use tracker::{Observation, SequenceTracker, TrackerCounters};

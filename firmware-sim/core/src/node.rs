@@ -17,10 +17,10 @@
 use heapless::{Deque, Vec};
 
 use crate::frame::{
-    AxisSet, DataFrame, DevicePage, FirmwareVersion, Frame, FrameKind, NodeInfo, SpeedFrame,
-    SpeedSource, StreamPage, SAMPLES_CAPACITY, SPEED_NOT_AVAILABLE,
+    AxisSet, DataFrame, DevicePage, FirmwareVersion, Frame, NodeInfo, SpeedFrame, SpeedSource,
+    StreamPage, SAMPLES_CAPACITY, SPEED_NOT_AVAILABLE,
 };
-use crate::id::{AXIS_COUNT, NODE_COUNT};
+use crate::id::{FrameKind, AXIS_COUNT, NODE_COUNT};
 
 /// What a node is and how it streams.
 #[derive(Debug, Clone, Copy, PartialEq)]

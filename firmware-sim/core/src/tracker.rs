@@ -40,7 +40,8 @@
 //! node's own counter only if the tracker saw the stream from the node's start; otherwise they
 //! differ from it by a multiple of 2^24, which does not matter to the analysis.
 
-use crate::frame::{DataFrame, FrameKind};
+use crate::frame::DataFrame;
+use crate::id::FrameKind;
 
 /// What a data frame is, relative to the ones before it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
