@@ -12,7 +12,13 @@ the layer order given by the `# Layout` section of SRC/lib.rs (the order its `- 
 are listed in, top to bottom: a module may use only modules listed after it). A module the
 layout does not list is only checked for cycles, and reported.
 
-Usage: scripts/module_deps.py [--src SRC] [--graph]
+With `--depth 2` it also checks, inside each top-level module that is a directory, that its
+files and sub-directories (`src/a/b.rs`, `src/a/b/**`: node `a::b`) form no import cycle, seen
+through `crate::a::b`, `super::b` and `use super::{b, c}` paths (`a/mod.rs` is that module's
+root and is not a node). Code inside `#[cfg(test)] mod NAME { ... }` is not counted there: a
+unit test may call the module above it (a measurement through the whole analysis).
+
+Usage: scripts/module_deps.py [--src SRC] [--depth 1|2] [--graph]
 """
 
 import argparse
@@ -21,6 +27,7 @@ import sys
 from pathlib import Path
 
 PATH_RE = re.compile(r"(?<![\w$])crate\s*::\s*(\{|[A-Za-z_]\w*)")
+SUB_PATH_RE = re.compile(r"(?<![\w$])(crate\s*::\s*\w+|super(?:\s*::\s*super)*)\s*::\s*(\{|[A-Za-z_]\w*)")
 LAYOUT_ITEM_RE = re.compile(r"^//!\s*-\s*\[`(\w+)`\]")
 
 
@@ -121,6 +128,64 @@ def dependencies(src: Path) -> dict:
     return {m: {d: at for d, at in used.items() if d in known} for m, used in deps.items()}
 
 
+TEST_MOD_RE = re.compile(r"#\[cfg\(test\)\]\s*(?:pub(?:\([^)]*\))?\s+)?mod\s+\w+\s*\{")
+
+
+def without_test_modules(code: str) -> str:
+    """`code` (already stripped of comments and literals) with every `#[cfg(test)] mod x { }`
+    body blanked, newlines kept so that line numbers stay right."""
+    out, i = [], 0
+    for m in TEST_MOD_RE.finditer(code):
+        if m.start() < i:
+            continue
+        depth, j = 1, m.end()
+        while j < len(code) and depth:
+            depth += {"{": 1, "}": -1}.get(code[j], 0)
+            j += 1
+        out.append(code[i:m.start()])
+        out.append(re.sub(r"[^\n]", " ", code[m.start():j]))
+        i = j
+    out.append(code[i:])
+    return "".join(out)
+
+
+def submodule_dependencies(src: Path, top: str) -> dict:
+    """{submodule: {used submodule: first file:line}} inside the directory module `top`."""
+    root = src / top
+    deps = {}
+    for path in sorted(root.rglob("*.rs")):
+        rel = path.relative_to(root)
+        if rel.parts == ("mod.rs",):
+            continue
+        node = rel.parts[0][:-3] if len(rel.parts) == 1 else rel.parts[0]
+        # The module `super` names: for src/top/b.rs it is `top`; for src/top/b/c.rs it is
+        # `top::b` (and `super::super` is `top`); a deeper file's `mod.rs` is its directory.
+        inner = list(rel.with_suffix("").parts)
+        if inner[-1] == "mod":
+            inner.pop()
+        deps.setdefault(node, {})
+        code = without_test_modules(strip_code(path.read_text(encoding="utf-8")))
+        for m in SUB_PATH_RE.finditer(code):
+            head = re.sub(r"\s", "", m.group(1))
+            if head.startswith("crate"):
+                if head.split("::")[1] != top:
+                    continue
+                base = []
+            else:
+                ups = head.count("super")
+                base = inner[:-ups] if ups <= len(inner) else None
+                if base is None:
+                    continue
+            names = group_names(code, m.start(2)) if m.group(2) == "{" else [m.group(2)]
+            line = code.count("\n", 0, m.start()) + 1
+            for name in names:
+                used = base[0] if base else name
+                if used not in (node, "self", "super", "crate"):
+                    deps[node].setdefault(used, f"{path}:{line}")
+    known = set(deps)
+    return {m: {d: at for d, at in used.items() if d in known} for m, used in deps.items()}
+
+
 def cycles(deps: dict) -> list:
     """The import cycles: for every strongly connected component with more than one module
     (Tarjan), a shortest cycle through each of its modules, without repeats."""
@@ -194,13 +259,23 @@ def layout_order(src: Path) -> list:
     return order
 
 
-def check(src: Path, show_graph: bool = False) -> list:
-    """The problems found (empty: none); prints the graph when asked."""
-    deps = dependencies(src)
+def cycle_problems(deps: dict, prefix: str = "") -> list:
     problems = []
     for cycle in cycles(deps):
-        arrows = [f"{a} -> {b} ({deps[a][b]})" for a, b in zip(cycle, cycle[1:])]
-        problems.append("import cycle: " + " -> ".join(cycle) + "\n    " + "\n    ".join(arrows))
+        named = [prefix + m for m in cycle]
+        arrows = [f"{prefix}{a} -> {prefix}{b} ({deps[a][b]})" for a, b in zip(cycle, cycle[1:])]
+        problems.append("import cycle: " + " -> ".join(named) + "\n    " + "\n    ".join(arrows))
+    return problems
+
+
+def check(src: Path, show_graph: bool = False, depth: int = 1) -> list:
+    """The problems found (empty: none); prints the graph when asked."""
+    deps = dependencies(src)
+    problems = cycle_problems(deps)
+    if depth >= 2:
+        for top in sorted(deps):
+            if (src / top).is_dir():
+                problems += cycle_problems(submodule_dependencies(src, top), f"{top}::")
     order = layout_order(src)
     rank = {m: i for i, m in enumerate(order)}
     for module in sorted(deps):
@@ -223,14 +298,17 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--src", default="src", type=Path)
     parser.add_argument("--graph", action="store_true", help="print every module's dependencies")
+    parser.add_argument("--depth", type=int, choices=(1, 2), default=1,
+                        help="2: also no cycle between the files of each top-level module")
     args = parser.parse_args()
-    problems = check(args.src, args.graph)
+    problems = check(args.src, args.graph, args.depth)
     for problem in problems:
         print(problem)
     if problems:
         print(f"{len(problems)} problem(s) in the module graph of {args.src}")
         return 1
-    print(f"module graph of {args.src}: no cycle, every arrow goes down the layout")
+    inside = " (nor inside a top-level module)" if args.depth >= 2 else ""
+    print(f"module graph of {args.src}: no cycle{inside}, every arrow goes down the layout")
     return 0
 
 

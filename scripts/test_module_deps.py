@@ -66,6 +66,23 @@ class ModuleDeps(unittest.TestCase):
         self.assertTrue(any(p.startswith("upward arrow: low uses top") for p in problems), problems)
         self.assertTrue(any(p.startswith("import cycle: low -> top -> low") for p in problems), problems)
 
+    def test_depth_two_finds_a_cycle_between_the_files_of_a_module(self):
+        src = tree({
+            "lib.rs": "pub mod a;\n",
+            "a/mod.rs": "mod b;\nmod c;\nmod d;\n",
+            "a/b.rs": "use super::c::X;\n",
+            "a/c/mod.rs": "use crate::a::{b::Y, b};\nuse crate::other::Q;\n",
+            "a/d.rs": "use super::b::Z;\n#[cfg(test)]\nmod tests {\n    use super::super::c::W;\n}\n",
+        })
+        self.assertEqual(module_deps.check(src, depth=1), [])
+        problems = module_deps.check(src, depth=2)
+        self.assertEqual(len(problems), 1, problems)
+        self.assertIn("import cycle: a::b -> a::c -> a::b", problems[0])
+        inner = module_deps.submodule_dependencies(src, "a")
+        self.assertEqual(inner["c"].keys(), {"b"})
+        # d's test module uses c: not counted (a unit test may call the module above it).
+        self.assertEqual(inner["d"].keys(), {"b"})
+
 
 if __name__ == "__main__":
     unittest.main()
