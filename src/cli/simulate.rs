@@ -3,9 +3,10 @@
 //! ringing a resonance, MODELS.md §4) or from the physics twin (the 6-DOF contact model,
 //! MODELS.md §5, optionally with parameters calibrated to a real machine).
 
-use super::twin_args::{DofArg, FaultArg};
+use super::twin_args::{DofArg, FaultArg, MachineFaultArg};
 use super::CliError;
 use crate::bearing::BearingGeometry;
+use crate::twin::machine_fault::MachineFault;
 use crate::twin::physics::{PhysicsModel, PhysicsParams};
 use crate::twin::{Nuisance, SimulationParams, Simulator};
 use clap::{Args, ValueEnum};
@@ -88,6 +89,12 @@ pub struct SimulateArgs {
     /// docs/DIAGNOSIS.md).
     #[arg(long)]
     nuisance: bool,
+    /// Signal model: add a fault of the machine (not of the bearing) at shaft orders.
+    #[arg(long, value_enum)]
+    machine_fault: Option<MachineFaultArg>,
+    /// RMS velocity of the machine fault's 1× line, mm/s.
+    #[arg(long, default_value_t = 4.0, requires = "machine_fault")]
+    machine_fault_velocity: f64,
     /// Signal model: the fault appears at this time, s.
     #[arg(long, default_value_t = 0.0)]
     onset: f64,
@@ -171,10 +178,16 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
                 defect_length_mm: args.defect_length,
                 noise_g: args.noise,
                 shaft_tone_g: 0.05,
-                nuisance: if args.nuisance {
-                    Nuisance::typical()
-                } else {
-                    Nuisance::none()
+                nuisance: Nuisance {
+                    machine_fault: args.machine_fault.map(|kind| MachineFault {
+                        kind: kind.into(),
+                        velocity_mm_s: args.machine_fault_velocity,
+                    }),
+                    ..if args.nuisance {
+                        Nuisance::typical()
+                    } else {
+                        Nuisance::none()
+                    }
                 },
                 onset_s: args.onset,
                 ramp_s: 0.0,
@@ -220,6 +233,12 @@ fn simulate_physics(
     bearing: BearingGeometry,
     duration: f64,
 ) -> Result<Vec<f32>, CliError> {
+    if args.machine_fault.is_some() {
+        return Err(CliError::input(
+            "--machine-fault is made by the signal model: use `--model signal` (the physics twin \
+             models the bearing and its housing only)",
+        ));
+    }
     let mut params = match &args.calibrated {
         Some(path) => {
             let text = std::fs::read_to_string(path).map_err(|e| {

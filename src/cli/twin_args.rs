@@ -1,7 +1,8 @@
 //! The twin's command-line choices shared by `bearingd simulate` and `bearingd calibrate`: the
-//! defect and the physics model's degrees of freedom. They live here, not in either command, so
+//! defect, the machine fault and the physics model's degrees of freedom. They live here, not in either command, so
 //! that neither command imports the other.
 
+use crate::twin::machine_fault::MachineFaultKind;
 use crate::twin::physics::Dof;
 use crate::twin::SimulatedFault;
 use clap::ValueEnum;
@@ -40,6 +41,26 @@ impl From<DofArg> for Dof {
         match dof {
             DofArg::Six => Dof::Six,
             DofArg::Five => Dof::Five,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MachineFaultArg {
+    /// A 1× line (once per revolution).
+    Unbalance,
+    /// 2× stronger than 1×, some 3×.
+    Misalignment,
+    /// Many running-speed harmonics and half orders.
+    Looseness,
+}
+
+impl From<MachineFaultArg> for MachineFaultKind {
+    fn from(kind: MachineFaultArg) -> Self {
+        match kind {
+            MachineFaultArg::Unbalance => MachineFaultKind::Unbalance,
+            MachineFaultArg::Misalignment => MachineFaultKind::Misalignment,
+            MachineFaultArg::Looseness => MachineFaultKind::Looseness,
         }
     }
 }

@@ -12,8 +12,9 @@
 //! [`Nuisance`] adds what a real machine adds and a detector must not take for a fault: shaft
 //! harmonics (looseness, misalignment), noise whose level follows the shaft angle, random
 //! impulses that repeat at no rate (debris, electrical spikes, knocks from elsewhere), a gear
-//! mesh tone modulated by its shaft, and an electrical tone. Each draws from its own random
-//! stream: with [`Nuisance::none`] the signal is exactly what it was without it.
+//! mesh tone modulated by its shaft, an electrical tone, and optionally a fault of the machine
+//! itself (unbalance, misalignment, looseness: [`crate::machine_fault`]). Each draws from its
+//! own random stream: with [`Nuisance::none`] the signal is exactly what it was without it.
 //!
 //! It is the one simulator of the project: `bearingd simulate`, `analyze --demo`, the
 //! firmware simulator and the daemon's embedded default all draw from [`Simulator`], which
@@ -21,6 +22,7 @@
 //! deterministic for a given seed.
 
 use crate::bearing::{BearingGeometry, FaultFrequencies, FaultKind, Race};
+use crate::machine_fault::{MachineFault, MachineVibration};
 use crate::random::Rng;
 use serde::{Deserialize, Serialize};
 
@@ -93,6 +95,10 @@ pub struct Nuisance {
     /// An electrical tone (e.g. twice the line frequency) at a fixed frequency.
     pub electrical_hz: f64,
     pub electrical_g: f64,
+    /// A fault of the machine, not of the bearing: unbalance, misalignment or looseness at
+    /// shaft orders (see [`crate::machine_fault`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub machine_fault: Option<MachineFault>,
 }
 
 impl Nuisance {
@@ -109,6 +115,7 @@ impl Nuisance {
             gear_mesh_g: 0.0,
             electrical_hz: 0.0,
             electrical_g: 0.0,
+            machine_fault: None,
         }
     }
 
@@ -128,6 +135,7 @@ impl Nuisance {
             gear_mesh_g: 0.2,
             electrical_hz: 100.0,
             electrical_g: 0.1,
+            machine_fault: None,
         }
     }
 
@@ -294,6 +302,8 @@ pub struct Simulator {
     next_random_impulse_s: f64,
     /// Phase of each shaft harmonic 2×, 3×, …, rad.
     harmonic_phases: Vec<f64>,
+    /// The machine fault's lines, if the nuisance has one.
+    machine: Option<MachineVibration>,
     next_sample: u64,
     next_impact_index: u64,
     ringing: Vec<Impact>,
@@ -319,7 +329,12 @@ impl Simulator {
         let harmonic_phases = (2..=params.nuisance.shaft_harmonic_count)
             .map(|_| std::f64::consts::TAU * phase_rng.uniform())
             .collect();
+        let machine = params
+            .nuisance
+            .machine_fault
+            .map(|fault| MachineVibration::new(&fault, seed));
         Simulator {
+            machine,
             noise_rng: Rng::new(seed),
             jitter_rng: Rng::new(seed ^ 0x5EED_0F11_77E5),
             cage_knock_rng: Rng::new(seed ^ 0xCA6E_0000_C0C0),
@@ -370,6 +385,9 @@ impl Simulator {
                     t,
                     &mut self.modulated_noise_rng,
                 );
+            }
+            if let Some(machine) = &self.machine {
+                x += machine.at(shaft_hz, t);
             }
             if cage {
                 let level =
