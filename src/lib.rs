@@ -47,6 +47,9 @@
 //!   speed sources and the pipeline's messages; MCAP and iceoryx2 encode them at the edge.
 //! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies and the
 //!   fault kinds (from the `bearing-signal` crate, shared with `firmware-sim`).
+//! - [`machine_fault`]: the machine faults beside the bearing (unbalance, misalignment,
+//!   looseness) and their patterns at shaft orders, which the simulator makes and the analysis
+//!   names (from `bearing-signal`).
 //! - [`random`]: seeded random numbers (ChaCha8), the same on every machine, for the simulator
 //!   and for tests at every level (from `bearing-signal`).
 //! - [`clock`]: the one reading of the system clock, for the daemon's edges (sources, sinks).
@@ -66,6 +69,7 @@ pub mod fsafe;
 pub mod iox;
 pub mod learned;
 pub mod life;
+pub use bearing_signal::machine_fault;
 pub mod mcap_log;
 pub mod messages;
 pub mod offline;

@@ -31,6 +31,7 @@ pub mod health;
 pub mod indicators;
 pub mod iso;
 pub mod kurtogram;
+pub mod machine;
 pub mod monitor;
 pub mod record;
 pub mod settings;

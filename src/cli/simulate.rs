@@ -6,7 +6,7 @@
 use super::twin_args::{DofArg, FaultArg, MachineFaultArg};
 use super::CliError;
 use crate::bearing::BearingGeometry;
-use crate::twin::machine_fault::MachineFault;
+use crate::machine_fault::MachineFault;
 use crate::twin::physics::{PhysicsModel, PhysicsParams};
 use crate::twin::{Nuisance, SimulationParams, Simulator};
 use clap::{Args, ValueEnum};

@@ -2,7 +2,7 @@
 //! defect, the machine fault and the physics model's degrees of freedom. They live here, not in either command, so
 //! that neither command imports the other.
 
-use crate::twin::machine_fault::MachineFaultKind;
+use crate::machine_fault::MachineFaultKind;
 use crate::twin::physics::Dof;
 use crate::twin::SimulatedFault;
 use clap::ValueEnum;

@@ -11,7 +11,6 @@ pub mod hw;
 pub mod model;
 pub mod optimize;
 pub mod physics;
-pub use bearing_signal::machine_fault;
 pub use bearing_signal::simulate;
 
 pub use fit::{FitBounds, HypothesisFit, TwinFitter, TwinParams};
