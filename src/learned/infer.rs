@@ -64,7 +64,7 @@ pub const HIDDEN_UNITS: usize = 32;
 /// The inputs of the hidden layer: the second convolution's channels after two 2× poolings.
 /// `None` when `bins` is not a positive multiple of 4 (or absurdly large).
 pub fn hidden_inputs(bins: usize) -> Option<usize> {
-    if bins == 0 || bins % 4 != 0 {
+    if bins == 0 || !bins.is_multiple_of(4) {
         return None;
     }
     CNN_CHANNELS.checked_mul(bins / 4)
