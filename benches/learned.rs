@@ -2,9 +2,10 @@
 //! reported in docs/PHYSICS.md, "Learned diagnosis" and docs/PERFORMANCE.md:
 //! - the input of one segment (24 revolutions' envelope spectrum on the order axis);
 //! - the network on one segment (autoencoder + CNN);
-//! - the whole opinion of a 10 s record (its segments, batched).
+//! - the whole opinion of a 10 s record (its segments, one after the other).
 //!
-//! Run: `cargo bench --bench learned`. One core: the matrix kernels' threads are set to 1.
+//! Run: `cargo bench --bench learned`. One core: the plain forward pass is single-threaded, and
+//! the threads of any other kernel (rayon) are set to 1.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::envelope::FftPlans;
@@ -40,7 +41,7 @@ fn learned(c: &mut Criterion) {
         },
     );
     c.bench_function("learned: network on one segment", |b| {
-        b.iter(|| model.classify(black_box(&input)).unwrap())
+        b.iter(|| model.classify(black_box(&input)))
     });
     c.bench_function("learned: opinion of a 10 s record", |b| {
         b.iter(|| {
@@ -52,7 +53,7 @@ fn learned(c: &mut Criterion) {
 }
 
 fn one_core() -> Criterion {
-    // candle's CPU kernels size their thread pool from this variable.
+    // rayon (candle's CPU kernels, when training code is measured) sizes its pool from this.
     std::env::set_var("RAYON_NUM_THREADS", "1");
     Criterion::default()
 }

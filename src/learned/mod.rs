@@ -1,18 +1,23 @@
 //! Learned diagnosis trained only on synthetic data (seed 001, issue 14 item 4): a denoising
 //! autoencoder + 1-D CNN that reads a record's envelope spectrum on the shaft-order axis and
-//! gives class probabilities, trained on `bearingd dataset` output by `bearingd train`, run on
-//! the CPU with candle. It is an extra opinion: the second witness of
+//! gives class probabilities, trained on `bearingd dataset` output by `bearingd train` (with
+//! candle) and run by a plain f32 forward pass (no training library in the service). It is an
+//! extra opinion: the second witness of
 //! [`crate::analysis::agreement::decide`], which may let the envelope name its first-ranked
 //! fault on less evidence but never overrules or replaces it.
 //!
 //! - [`features`]: the input (order spectrum of a segment), the same in training and use;
-//! - [`network`]: the autoencoder and the classifier;
-//! - [`model`]: a trained model file (weights + model card) and its opinion of a record;
-//! - [`train`]: training on a data set, seeded;
+//! - [`network`]: the autoencoder and the classifier, trainable (candle);
+//! - [`infer`]: the same network's forward pass in plain f32, what a trained model runs;
+//! - [`file`]: reading a model file (safetensors layout), bounded, every flaw a clear error;
+//! - [`model`]: a trained model (weights + model card) and its opinion of a record;
+//! - [`train`]: training on a data set, seeded, and writing the model file;
 //! - [`combine`]: the model as that witness, and what the report says of the outcome.
 
 pub mod combine;
 pub mod features;
+pub mod file;
+pub mod infer;
 pub mod model;
 pub mod network;
 pub mod train;

@@ -1,23 +1,23 @@
 //! A trained model: the network's weights and its model card (classes, bearing, input
 //! settings, how it was trained) in one safetensors file, so that a model file says what it is
 //! for and is refused, with the fix, where it does not apply.
+//!
+//! Using a model needs no training library: the file is read by [`super::file`] and the
+//! network run by [`super::infer`]. Writing one is training's ([`super::train`]).
 
 use super::features::FeatureSettings;
-use super::network::Network;
+use super::file::{FileError, ModelFile};
+use super::infer::{Scratch, Weights};
 use crate::analysis::envelope::FftPlans;
 use crate::bearing::BearingGeometry;
 use crate::twin::SimulatedFault;
-use candle_core::{DType, Device, Tensor};
-use candle_nn::ops::softmax;
-use candle_nn::VarBuilder;
 use serde::{Deserialize, Serialize};
-use std::collections::HashMap;
 use std::path::Path;
 
 /// The metadata key of the model card in the safetensors header.
-const CARD_KEY: &str = "bearingd.model_card";
+pub(super) const CARD_KEY: &str = "bearingd.model_card";
 /// The card's format; a file of another format is refused.
-const CARD_FORMAT: u32 = 1;
+pub(super) const CARD_FORMAT: u32 = 1;
 
 /// What a model is and how it was made.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -59,8 +59,6 @@ pub enum ModelError {
         trained: String,
         given: String,
     },
-    #[error("the network failed: {0}")]
-    Network(#[from] candle_core::Error),
     #[error("{file}: cannot write: {why}")]
     Write { file: String, why: String },
 }
@@ -69,7 +67,7 @@ pub struct LearnedModel {
     pub card: ModelCard,
     /// Where it was read from (`trained` for a model fresh from training).
     pub file: String,
-    network: Network,
+    weights: Weights,
 }
 
 impl std::fmt::Debug for LearnedModel {
@@ -102,31 +100,48 @@ impl LearnedOpinion {
 }
 
 impl LearnedModel {
-    /// A model around a trained network (`bearingd train`).
-    pub(super) fn from_parts(card: ModelCard, network: Network) -> Self {
-        LearnedModel {
-            card,
-            file: "trained".into(),
-            network,
-        }
-    }
-
-    pub fn load(path: &Path) -> Result<Self, ModelError> {
-        let file = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| ModelError::Read {
-            file: file.clone(),
-            source,
-        })?;
+    /// A model of `card` whose weights are asked of `tensor(name, shape)`: a model file's, or
+    /// a network's fresh from training (`file` says which). A tensor that is missing or does
+    /// not fit the network makes it [`ModelError::NotAModel`].
+    pub(super) fn from_tensors(
+        card: ModelCard,
+        file: String,
+        mut tensor: impl FnMut(&str, &[usize]) -> Result<Vec<f32>, FileError>,
+    ) -> Result<Self, ModelError> {
+        let bins = card.features.order_bins;
         let not_a_model = |why: String| ModelError::NotAModel {
             file: file.clone(),
             why,
         };
-        let (_, header) = safetensors::SafeTensors::read_metadata(&bytes)
-            .map_err(|e| not_a_model(format!("not a safetensors file: {e}")))?;
-        let card_json = header
-            .metadata()
-            .as_ref()
-            .and_then(|m| m.get(CARD_KEY))
+        let weights = Weights::from_tensors(
+            bins,
+            card.classes.len(),
+            |name, shape| {
+                tensor(name, shape)
+                    .map_err(|e| not_a_model(format!("its weights do not fit the network: {e}")))
+            },
+            || {
+                not_a_model(format!(
+                    "its model card's order_bins {bins} is not a positive multiple of 4"
+                ))
+            },
+        )?;
+        Ok(LearnedModel {
+            card,
+            file,
+            weights,
+        })
+    }
+
+    pub fn load(path: &Path) -> Result<Self, ModelError> {
+        let file = path.display().to_string();
+        let model_file = ModelFile::read(path).map_err(|e| model_error(&file, e))?;
+        let not_a_model = |why: String| ModelError::NotAModel {
+            file: file.clone(),
+            why,
+        };
+        let card_json = model_file
+            .metadata(CARD_KEY)
             .ok_or_else(|| not_a_model(format!("no {CARD_KEY} in its header")))?;
         let card: ModelCard = serde_json::from_str(card_json)
             .map_err(|e| not_a_model(format!("its model card does not read: {e}")))?;
@@ -136,60 +151,28 @@ impl LearnedModel {
                 card.format
             )));
         }
-        let vb = VarBuilder::from_buffered_safetensors(bytes, DType::F32, &Device::Cpu)?;
-        let network = Network::new(vb, card.features.order_bins, card.classes.len())
-            .map_err(|e| not_a_model(format!("its weights do not fit the network: {e}")))?;
-        Ok(LearnedModel {
-            card,
-            file,
-            network,
+        Self::from_tensors(card, file.clone(), |name, shape| {
+            model_file.tensor(name, shape)
         })
     }
 
-    /// Writes the weights in `tensors` (name → tensor) and the card.
-    pub(super) fn save(
-        path: &Path,
-        card: &ModelCard,
-        tensors: &HashMap<String, Tensor>,
-    ) -> Result<(), ModelError> {
-        let file = path.display().to_string();
-        let write = |why: String| ModelError::Write {
-            file: file.clone(),
-            why,
-        };
-        let mut names: Vec<&String> = tensors.keys().collect();
-        names.sort();
-        let mut buffers = Vec::with_capacity(names.len());
-        for name in &names {
-            let tensor = &tensors[*name];
-            let values: Vec<f32> = tensor.flatten_all()?.to_vec1()?;
-            let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
-            buffers.push((name.to_string(), tensor.dims().to_vec(), bytes));
-        }
-        let views = buffers
-            .iter()
-            .map(|(name, shape, bytes)| {
-                safetensors::tensor::TensorView::new(safetensors::Dtype::F32, shape.clone(), bytes)
-                    .map(|view| (name.clone(), view))
-                    .map_err(|e| write(e.to_string()))
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let card_json = serde_json::to_string(card).map_err(|e| write(e.to_string()))?;
-        let metadata = HashMap::from([(CARD_KEY.to_string(), card_json)]);
-        safetensors::serialize_to_file(views, Some(metadata), path)
-            .map_err(|e| write(e.to_string()))
+    /// Class probabilities of each input (`order_bins` values each): `[segments][classes]`.
+    pub fn classify(&self, inputs: &[f32]) -> Vec<Vec<f32>> {
+        let mut all = Vec::new();
+        self.for_each_segment(inputs, |probabilities| all.push(probabilities.to_vec()));
+        all
     }
 
-    /// Class probabilities of each input (`order_bins` values each): `[segments][classes]`.
-    pub fn classify(&self, inputs: &[f32]) -> Result<Vec<Vec<f32>>, ModelError> {
-        let bins = self.card.features.order_bins;
-        let segments = inputs.len() / bins;
-        if segments == 0 {
-            return Ok(Vec::new());
+    /// Calls `each` with the class probabilities of every whole input (`order_bins` values) in
+    /// `inputs`, reusing one set of buffers.
+    fn for_each_segment(&self, inputs: &[f32], mut each: impl FnMut(&[f32])) {
+        let mut scratch = Scratch::default();
+        let mut probabilities = vec![0f32; self.weights.classes()];
+        for input in inputs.chunks_exact(self.weights.bins()) {
+            self.weights
+                .probabilities(input, &mut scratch, &mut probabilities);
+            each(&probabilities);
         }
-        let batch = Tensor::from_slice(&inputs[..segments * bins], (segments, bins), &Device::Cpu)?;
-        let logits = self.network.forward(&batch)?.logits;
-        Ok(softmax(&logits, 1)?.to_vec2()?)
     }
 
     /// The model's opinion of a record (`samples` in any unit, at `fs_hz`, shaft at
@@ -218,19 +201,19 @@ impl LearnedModel {
             .card
             .features
             .record_inputs(&mut plans, samples, fs_hz, shaft_hz);
-        let per_segment = self.classify(&inputs)?;
+        let segments = inputs.len() / self.weights.bins();
         let mut mean = vec![0f64; self.card.classes.len()];
-        for probabilities in &per_segment {
+        self.for_each_segment(&inputs, |probabilities| {
             for (m, p) in mean.iter_mut().zip(probabilities) {
-                *m += f64::from(*p) / per_segment.len() as f64;
+                *m += f64::from(*p) / segments as f64;
             }
-        }
+        });
         let mut probabilities: Vec<(SimulatedFault, f64)> =
             self.card.classes.iter().copied().zip(mean).collect();
         probabilities.sort_by(|a, b| b.1.total_cmp(&a.1));
         Ok(LearnedOpinion {
             model: self.file.clone(),
-            segments: per_segment.len(),
+            segments,
             probabilities,
         })
     }
@@ -260,5 +243,19 @@ impl LearnedModel {
                 given: bearing.spec(),
             })
         }
+    }
+}
+
+/// A model file's problem as the error naming it.
+fn model_error(file: &str, e: FileError) -> ModelError {
+    match e {
+        FileError::Read(source) => ModelError::Read {
+            file: file.to_string(),
+            source,
+        },
+        FileError::Malformed(why) => ModelError::NotAModel {
+            file: file.to_string(),
+            why,
+        },
     }
 }

@@ -4,16 +4,17 @@
 //!
 //! Sizes (choice): three 9-tap convolutions for the autoencoder (1 → 8 → 8 → 1 channels), two
 //! convolutions with 2× pooling and a 32-unit hidden layer for the classifier: about 27,000
-//! weights, 105 KiB, a fraction of a millisecond per segment on one core.
+//! weights, 105 KiB, a fraction of a millisecond per segment on one core. The sizes and tensor
+//! names are [`super::infer`]'s, whose plain forward pass is what a trained model runs.
+//!
+//! This candle network is for training only (it can learn); a test holds its forward pass and
+//! [`super::infer`]'s to the same probabilities.
 
+use super::infer::{
+    self, ConvShape, CLASSES, CNN_FIRST, CNN_SECOND, DAE_IN, DAE_MID, DAE_OUT, HIDDEN, HIDDEN_UNITS,
+};
 use candle_core::{Module, Result, Tensor};
 use candle_nn::{conv1d, linear, Conv1d, Conv1dConfig, Linear, VarBuilder};
-
-/// Kernel of the autoencoder's convolutions.
-const DAE_KERNEL: usize = 9;
-const DAE_CHANNELS: usize = 8;
-const CNN_CHANNELS: usize = 16;
-const HIDDEN: usize = 32;
 
 pub struct Network {
     dae_in: Conv1d,
@@ -36,36 +37,30 @@ pub struct Forward {
 impl Network {
     /// `bins` must be a multiple of 4 (two 2× poolings).
     pub fn new(vb: VarBuilder, bins: usize, classes: usize) -> Result<Self> {
-        let same = |kernel: usize| Conv1dConfig {
-            padding: kernel / 2,
-            ..Conv1dConfig::default()
+        let hidden_inputs = infer::hidden_inputs(bins).ok_or_else(|| {
+            candle_core::Error::Msg(format!("{bins} bins: not a positive multiple of 4"))
+        })?;
+        let conv = |shape: ConvShape| {
+            let same = Conv1dConfig {
+                padding: shape.kernel / 2,
+                ..Conv1dConfig::default()
+            };
+            conv1d(
+                shape.inputs,
+                shape.outputs,
+                shape.kernel,
+                same,
+                vb.pp(shape.name),
+            )
         };
         Ok(Network {
-            dae_in: conv1d(
-                1,
-                DAE_CHANNELS,
-                DAE_KERNEL,
-                same(DAE_KERNEL),
-                vb.pp("dae_in"),
-            )?,
-            dae_mid: conv1d(
-                DAE_CHANNELS,
-                DAE_CHANNELS,
-                DAE_KERNEL,
-                same(DAE_KERNEL),
-                vb.pp("dae_mid"),
-            )?,
-            dae_out: conv1d(
-                DAE_CHANNELS,
-                1,
-                DAE_KERNEL,
-                same(DAE_KERNEL),
-                vb.pp("dae_out"),
-            )?,
-            cnn_first: conv1d(1, CNN_CHANNELS, 7, same(7), vb.pp("cnn_first"))?,
-            cnn_second: conv1d(CNN_CHANNELS, CNN_CHANNELS, 5, same(5), vb.pp("cnn_second"))?,
-            hidden: linear(CNN_CHANNELS * (bins / 4), HIDDEN, vb.pp("hidden"))?,
-            classes: linear(HIDDEN, classes, vb.pp("classes"))?,
+            dae_in: conv(DAE_IN)?,
+            dae_mid: conv(DAE_MID)?,
+            dae_out: conv(DAE_OUT)?,
+            cnn_first: conv(CNN_FIRST)?,
+            cnn_second: conv(CNN_SECOND)?,
+            hidden: linear(hidden_inputs, HIDDEN_UNITS, vb.pp(HIDDEN))?,
+            classes: linear(HIDDEN_UNITS, classes, vb.pp(CLASSES))?,
         })
     }
 

@@ -8,7 +8,8 @@
 //! thread counts).
 
 use super::features::FeatureSettings;
-use super::model::{LearnedModel, ModelCard, ModelError, TrainingSummary};
+use super::file::FileError;
+use super::model::{LearnedModel, ModelCard, ModelError, TrainingSummary, CARD_FORMAT, CARD_KEY};
 use super::network::Network;
 use crate::analysis::envelope::FftPlans;
 use crate::random::Rng;
@@ -17,7 +18,7 @@ use crate::twin::SimulatedFault;
 use candle_core::{DType, Device, Tensor, D};
 use candle_nn::{loss, AdamW, Optimizer, ParamsAdamW, VarBuilder, VarMap};
 use rayon::prelude::*;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
 /// How to train (`bearingd train` options).
@@ -67,12 +68,8 @@ pub enum TrainingError {
     DataSet { file: String, why: String },
     #[error(transparent)]
     Model(#[from] ModelError),
-}
-
-impl From<candle_core::Error> for TrainingError {
-    fn from(e: candle_core::Error) -> Self {
-        TrainingError::Model(ModelError::Network(e))
-    }
+    #[error("the network failed: {0}")]
+    Network(#[from] candle_core::Error),
 }
 
 /// One epoch's numbers, for progress.
@@ -219,14 +216,49 @@ impl TrainingSet {
 /// A trained model, its weights by name (to save) and its last epoch's numbers.
 pub struct Trained {
     pub model: LearnedModel,
-    weights: HashMap<String, Tensor>,
+    weights: BTreeMap<String, PlainTensor>,
     pub last_epoch: EpochReport,
 }
 
+/// A tensor's shape and values, out of candle.
+struct PlainTensor {
+    shape: Vec<usize>,
+    values: Vec<f32>,
+}
+
 impl Trained {
-    /// Writes the model file (weights and card).
+    /// Writes the model file (weights and card) in the layout [`super::file`] reads.
     pub fn save(&self, path: &Path) -> Result<(), ModelError> {
-        LearnedModel::save(path, &self.model.card, &self.weights)
+        let file = path.display().to_string();
+        let write = |why: String| ModelError::Write {
+            file: file.clone(),
+            why,
+        };
+        let bytes: Vec<(&String, &PlainTensor, Vec<u8>)> = self
+            .weights
+            .iter()
+            .map(|(name, tensor)| {
+                let bytes = tensor.values.iter().flat_map(|v| v.to_le_bytes()).collect();
+                (name, tensor, bytes)
+            })
+            .collect();
+        let views = bytes
+            .iter()
+            .map(|(name, tensor, bytes)| {
+                safetensors::tensor::TensorView::new(
+                    safetensors::Dtype::F32,
+                    tensor.shape.clone(),
+                    bytes,
+                )
+                .map(|view| (name.to_string(), view))
+                .map_err(|e| write(e.to_string()))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let card_json =
+            serde_json::to_string(&self.model.card).map_err(|e| write(e.to_string()))?;
+        let metadata = HashMap::from([(CARD_KEY.to_string(), card_json)]);
+        safetensors::serialize_to_file(views, Some(metadata), path)
+            .map_err(|e| write(e.to_string()))
     }
 }
 
@@ -288,7 +320,7 @@ pub fn train(
         progress(&report);
     }
     let card = ModelCard {
-        format: 1,
+        format: CARD_FORMAT,
         classes,
         bearing: set.spec.bearing.clone(),
         features: set.features,
@@ -306,10 +338,24 @@ pub fn train(
         .lock()
         .map_err(|_| candle_core::Error::Msg("the weights' lock is poisoned".into()))?
         .iter()
-        .map(|(name, var)| (name.clone(), var.as_tensor().clone()))
-        .collect::<HashMap<_, _>>();
+        .map(|(name, var)| {
+            let tensor = PlainTensor {
+                shape: var.dims().to_vec(),
+                values: var.as_tensor().flatten_all()?.to_vec1()?,
+            };
+            Ok((name.clone(), tensor))
+        })
+        .collect::<candle_core::Result<BTreeMap<_, _>>>()?;
+    let model = LearnedModel::from_tensors(card, "trained".into(), |name, shape| {
+        match weights.get(name) {
+            Some(tensor) if tensor.shape == shape => Ok(tensor.values.clone()),
+            _ => Err(FileError::Malformed(format!(
+                "training made no tensor {name:?} of shape {shape:?}"
+            ))),
+        }
+    })?;
     Ok(Trained {
-        model: LearnedModel::from_parts(card, network),
+        model,
         weights,
         last_epoch: report,
     })
