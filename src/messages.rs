@@ -502,3 +502,99 @@ pub enum PipelineMessage {
     Velocity(VelocityMessage),
     VelocityFlag(VelocityFlagMessage),
 }
+
+/// What happened to the alert of one (channel, flag).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[repr(u8)]
+pub enum AlertState {
+    /// The flag left `ok`.
+    Raised = 1,
+    /// Its severity went up (watch → alarm).
+    Escalated = 2,
+    /// Its severity went down but the flag is still up (alarm → watch).
+    Relaxed = 3,
+    /// The flag is back to `ok`: the alert is no longer active.
+    Cleared = 4,
+    /// Nothing changed: an active alert sent again so that it stays in the alert service's
+    /// history for subscribers that connect later.
+    Repeated = 5,
+}
+
+impl AlertState {
+    pub const ALL: [AlertState; 5] = [
+        AlertState::Raised,
+        AlertState::Escalated,
+        AlertState::Relaxed,
+        AlertState::Cleared,
+        AlertState::Repeated,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            AlertState::Raised => "raised",
+            AlertState::Escalated => "escalated",
+            AlertState::Relaxed => "relaxed",
+            AlertState::Cleared => "cleared",
+            AlertState::Repeated => "repeated",
+        }
+    }
+
+    /// The state of a flag change from `from` to `to`.
+    pub fn of_change(from: FlagLevel, to: FlagLevel) -> AlertState {
+        match (from, to) {
+            (FlagLevel::Ok, _) => AlertState::Raised,
+            (_, FlagLevel::Ok) => AlertState::Cleared,
+            _ if to > from => AlertState::Escalated,
+            _ => AlertState::Relaxed,
+        }
+    }
+}
+
+/// Which flag an alert is about: a fault kind's, or the ISO velocity zone's.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AlertSubject {
+    Fault(FaultKind),
+    IsoZone,
+}
+
+impl AlertSubject {
+    /// The wire name: a fault kind's (`outer_race`, …) or `iso_zone`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AlertSubject::Fault(fault) => fault.name(),
+            AlertSubject::IsoZone => VELOCITY_FLAG_NAME,
+        }
+    }
+}
+
+/// A flag change as an alert, decided once by the pipeline (`pipeline::alerts`) right after
+/// the flag's message: numbered, with its confidence. Not logged (the MCAP log has the flag
+/// itself, and the alert follows from it); the iceoryx2 publisher stamps the wall time and
+/// sends it (`docs/ALERTS.md`), the fleet bridge takes its confidence.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AlertMessage {
+    /// 1 for the first alert of a run, +1 for each next one.
+    pub sequence: u64,
+    /// The run that numbers it (the daemon's start, ns since the epoch).
+    pub run_id: u64,
+    pub channel: ChannelId,
+    /// The flag's `end_sample`.
+    pub end_sample: u64,
+    pub sample_rate_hz: f64,
+    pub subject: AlertSubject,
+    pub state: AlertState,
+    pub severity: FlagLevel,
+    pub previous_severity: FlagLevel,
+    /// The fault's envelope-spectrum score; for the velocity zone, the velocity RMS in mm/s.
+    pub score: f64,
+    /// 0.5 (undecided) to 1: how clearly the score stands above the thresholds and the other
+    /// faults' scores, moved by the twin's latest fit; 1 for the velocity zone (a measurement).
+    pub confidence: f64,
+    /// The frequency the fault's flag watches; `None` for the velocity zone.
+    pub fault_frequency_hz: Option<f64>,
+    /// The twin's fit error for this fault's hypothesis; `None` before the channel's first fit
+    /// and where the twin has no hypothesis (cage, velocity zone).
+    pub twin_error: Option<f64>,
+}

@@ -10,11 +10,11 @@ use super::CliError;
 use crate::config::{self, Config};
 use crate::daemon::events::{DaemonEvent, Events};
 use crate::daemon::lock::DirLock;
-use crate::daemon::{replay, BaselinesFrom, ReplayOptions, ReplaySummary, RunStart};
+use crate::daemon::{assemble, replay, BaselinesFrom, ReplayOptions, ReplaySummary, RunStart};
+use crate::daemon::{SinkPlan, Sinks};
 use crate::mcap_log::files::utc_text;
 use crate::mcap_log::LogHeader;
 use crate::pipeline::{Sink, SinkError};
-use crate::sinks::mcap::McapSink;
 use crate::sources::replay::plan::{differences, file_list, LoggedSettings, ReplayPlan};
 use clap::Args;
 use std::io::IsTerminal;
@@ -95,17 +95,6 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     // Created 0750, and refused if others can write in it (they could plant links there).
     crate::fsafe::prepare_private_dir(&args.out).map_err(CliError::input)?;
     let _lock = DirLock::acquire(&args.out).map_err(CliError::input)?;
-    let mut open_sinks =
-        |run: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {
-            let run_id = run.run_id.unwrap_or(run.origin_ns);
-            let (sink, _) = McapSink::for_run(&config, run.origin_ns, run_id, &run.baselines)
-                .map_err(|e| SinkError {
-                    sink: "MCAP log",
-                    count: 1,
-                    first: Box::new(e),
-                })?;
-            Ok(vec![Box::new(sink)])
-        };
     let bar = progress_bar(args, plan.bytes());
     let options = ReplayOptions {
         speed: args.speed,
@@ -118,6 +107,15 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     let events = match &bar {
         Some(bar) => bar_events(bar.clone()),
         None => print_events(),
+    };
+    let mut open_sinks = |run: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {
+        let sinks = assemble(
+            &config,
+            SinkPlan::replay(Vec::new()),
+            &run.sink_start(),
+            &events,
+        )?;
+        Ok(Sinks::all(sinks))
     };
     let replayed = replay(&plan, &config.clone(), &options, &mut open_sinks, &events);
     if let Some(bar) = &bar {

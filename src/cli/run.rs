@@ -4,7 +4,7 @@
 use super::CliError;
 use crate::config::{self, Config};
 use crate::daemon::state::StateError;
-use crate::daemon::{run, DaemonEvent, Events, RunOptions};
+use crate::daemon::{run, DaemonEvent, Events, RunOptions, SinkPlan};
 use crate::mcap_log::files::utc_text;
 use crate::messages::{FlagMessage, HealthKind, PipelineMessage, SpeedSource};
 use crate::pipeline::{ChannelStatus, Sink, SinkError};
@@ -136,7 +136,7 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         .enable_all()
         .build()
         .map_err(|e| CliError::failure(format!("cannot start the async runtime: {e}")))?;
-    let sinks: Vec<Box<dyn Sink>> = vec![Box::new(FlagPrinter)];
+    let sinks = SinkPlan::run(vec![Box::new(FlagPrinter)]);
     let summary = runtime.block_on(async {
         let shutdown = shutdown_signal().map_err(|e| {
             CliError::failure(format!("cannot install the SIGINT/SIGTERM handlers: {e}"))

@@ -3,6 +3,7 @@
 //!
 //! - [`run`]: threads, queues, shutdown and status of `bearingd run`.
 //! - [`replay`]: logged raw samples through the same pipeline, into the same sinks.
+//! - [`sinks`]: which sinks a run or a replay gets, assembled in one place.
 //! - [`events`]: what the daemon tells its operator, as typed events for the caller to show
 //!   (the daemon never prints).
 //! - [`cpu_latency`]: the CPUs' wake-up latency held down while it runs (an alert's latency).
@@ -14,8 +15,10 @@ pub mod events;
 pub mod lock;
 pub mod replay;
 pub mod run;
+pub mod sinks;
 pub mod state;
 
 pub use events::{ignore_events, DaemonEvent, Events};
 pub use replay::{replay, BaselinesFrom, Gap, ReplayError, ReplayOptions, ReplaySummary, RunStart};
 pub use run::{run, RunError, RunOptions, RunSummary};
+pub use sinks::{assemble, SinkPlan, SinkStart, SinkStartError, Sinks};

@@ -28,7 +28,7 @@ use crate::config::Config;
 use crate::mcap_log::ReadSummary;
 use crate::messages::{ChannelId, FlagMessage, PipelineMessage};
 use crate::pipeline::load_learned;
-use crate::pipeline::{Input, Output, Pipeline, Sink, SinkError, TwinWorker};
+use crate::pipeline::{Input, Output, Pipeline, Sink, SinkError, SinkItem, TwinWorker};
 use crate::sources::replay::plan::{PlannedRun, ReplayPlan};
 use crate::sources::replay::ReplaySource;
 use std::collections::{BTreeMap, HashMap};
@@ -60,6 +60,18 @@ pub struct RunStart {
     /// Those baselines (the replay's own log records them, as the daemon's did).
     #[serde(skip)]
     pub baselines: BTreeMap<ChannelId, Baseline>,
+}
+
+impl RunStart {
+    /// What the run's sinks need ([`super::sinks::assemble`]): its id (the original run's, or
+    /// its origin for files without metadata), origin and baselines.
+    pub fn sink_start(&self) -> super::sinks::SinkStart<'_> {
+        super::sinks::SinkStart {
+            run_id: self.run_id.unwrap_or(self.origin_ns),
+            origin_ns: self.origin_ns,
+            baselines: &self.baselines,
+        }
+    }
 }
 
 /// Where a replayed run's starting health baselines came from.
@@ -223,11 +235,14 @@ impl<'a> RunReplay<'a> {
         options: &ReplayOptions,
     ) -> Result<Self, ReplayError> {
         let learned = load_learned(&config.twin)?;
+        // The alerts are numbered as the original run's (its id; the first block's time for
+        // files without metadata is not known yet: their origin, if any).
         let pipeline = Pipeline::new(
             config,
             &start_baselines,
             learned.clone().map(|m| m as Arc<dyn Witness>),
-        );
+        )
+        .with_run_id(run.run_id.or(run.origin_ns).unwrap_or(0));
         let worker = TwinWorker::new(&config.twin, learned);
         let paths = plan.paths(run);
         let source = ReplaySource::open(
@@ -366,21 +381,33 @@ impl<'a> RunReplay<'a> {
         }
     }
 
-    /// One output of the pipeline: a message to every sink, a twin request fitted now (the
-    /// twin's fit, then the HW model's, as the daemon's re-fit thread hands them on).
+    /// One output of the pipeline: a message or an alert to every sink, a twin request fitted
+    /// now (the twin's fit, then the HW model's, as the daemon's re-fit thread hands them on;
+    /// the twin's into the pipeline too, as the daemon's analysis thread takes it).
     fn deliver(&mut self, output: Output, flags: &mut Vec<FlagMessage>) {
-        let sinks = &mut self.sinks;
-        let mut write = |message: PipelineMessage| {
-            if let PipelineMessage::Flag(flag) = &message {
+        let RunReplay {
+            sinks,
+            pipeline,
+            worker,
+            ..
+        } = self;
+        let mut hand_over = |item: SinkItem| {
+            if let SinkItem::Message(PipelineMessage::Flag(flag)) = &item {
                 flags.push(flag.clone());
             }
             for sink in sinks.iter_mut().flatten() {
-                sink.write(&message);
+                item.deliver_to(sink.as_mut());
             }
         };
         match output {
-            Output::Message(message) => write(message),
-            Output::Twin(request) => self.worker.refit(&request, &mut write),
+            Output::Message(message) => hand_over(SinkItem::Message(message)),
+            Output::Alert(alert) => hand_over(SinkItem::Alert(alert)),
+            Output::Twin(request) => worker.refit(&request, &mut |fit| {
+                if let PipelineMessage::Twin(twin) = &fit {
+                    pipeline.note_twin(twin);
+                }
+                hand_over(SinkItem::Message(fit));
+            }),
         }
     }
 }

@@ -2,17 +2,19 @@
 //! their own thread and status on the async side.
 //!
 //! [`run`] is a sequence of named steps: prepare the state directory and the iceoryx2 root,
-//! lock the data directories, open the sources' devices, start the alert service and the fleet
-//! bridge, open the log (last, so that a refused start leaves no file), start the threads, start the sources, supervise until a stop, stop in
-//! order. Each thread owns its state and talks to the others over bounded channels only:
+//! lock the data directories, open the sources' devices, assemble the sinks
+//! ([`super::sinks`]: the alert service, the fleet bridge, the log last, so that a refused
+//! start leaves no file), start the threads, start the sources, supervise until a stop, stop
+//! in order. Each thread owns its state and talks to the others over bounded channels only:
 //!
 //! - async (tokio): sources, signals, status. Sources send into the analysis queue
 //!   ([`ANALYSIS_QUEUE`]) and wait when it is full (`Block`): an in-process source is simply
 //!   slowed; a transport source then backs up into its own buffer, where a loss shows as an
 //!   exact sequence gap.
-//! - analysis thread ([`AnalysisThread`]): owns the [`Pipeline`] and the alert sink;
-//!   publishes the alerts of flag changes itself (iceoryx2's send does not block), hands each
-//!   input's messages to the sink queue (`Block`) once its alerts are out, and hands twin
+//! - analysis thread ([`AnalysisThread`]): owns the [`Pipeline`] and the immediate sinks (the
+//!   alert publisher); hands each output to the immediate sinks as it comes, so the pipeline's
+//!   alerts are published on this thread (iceoryx2's send does not block), hands each input's
+//!   messages and alerts to the sink queue (`Block`) once they are all out, and hands twin
 //!   requests to the re-fit
 //!   hand-over ([`crate::pipeline::twin_queue`]: one slot per channel, served in turn; a request
 //!   still waiting when its channel asks again is dropped, counted and reported). Band
@@ -27,8 +29,8 @@
 //!   analysis thread through a bounded hand-over (two slots per channel, plus two; the re-fit
 //!   thread waits when it is full), and
 //!   the analysis thread passes them on to the sinks, so that the sink queue has one producer.
-//! - sink thread: the sinks (log, flag printer); it owns the files, so flushing and finishing
-//!   them at shutdown happens there.
+//! - sink thread: the queued sinks (log, fleet bridge, flag printer); it owns the files, so
+//!   flushing and finishing them at shutdown happens there.
 //!
 //! Every thread but the analysis thread runs at a lower CPU priority
 //! ([`crate::pipeline::priority`]), so that the daemon's own background work never preempts
@@ -41,26 +43,21 @@
 use super::cpu_latency::{CpuLatencyCap, CPU_LATENCY_DEVICE};
 use super::events::{DaemonEvent, Events};
 use super::lock::{DirLock, LockError};
+use super::sinks::{assemble, SinkPlan, SinkStart, SinkStartError, Sinks};
 use super::state::{load_baselines, save_baselines};
 use crate::analysis::agreement::Witness;
-use crate::analysis::health::Baseline;
 use crate::clock::wall_clock_now_ns;
 use crate::config::{Config, Transport};
-use crate::mcap_log::McapLogError;
-use crate::messages::{ChannelId, FlagMessage, PipelineMessage};
+use crate::messages::{FlagMessage, PipelineMessage};
 use crate::pipeline::load_learned;
 use crate::pipeline::twin_queue::{twin_requests, TwinRequestQueue, TwinRequests};
-use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, TwinWorker};
-use crate::sinks::alerts::PublisherSummary;
-use crate::sinks::fleet::FleetSink;
-use crate::sinks::mcap::McapSink;
+use crate::pipeline::{ChannelStatus, Output, Pipeline, Sink, SinkError, SinkItem, TwinWorker};
 use crate::sinks::systemd::{keep_alive, status_text, Notifier};
 use crate::sources::live::{can_interfaces, shm_sensors};
 #[cfg(any(feature = "can", feature = "shm"))]
 use crate::sources::live::{forward, SENSOR_TIMEOUT};
 use crate::sources::sim::SimSource;
 use crate::sources::Arrived;
-use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{mpsc, Arc};
 use std::time::Duration;
@@ -97,13 +94,8 @@ pub enum RunError {
     UnsafeDir(#[from] crate::fsafe::UnsafeDir),
     #[error("{0} (the default root is under $XDG_RUNTIME_DIR, else /run/bearingd; outputs.iceoryx2_root sets another)")]
     IoxRoot(crate::fsafe::UnsafeDir),
-    #[error("MCAP log: {0}")]
-    Log(#[from] McapLogError),
-    #[cfg(feature = "shm")]
-    #[error("alerts: {0}")]
-    Alerts(#[from] crate::sinks::alerts::AlertError),
-    #[error("fleet bridge: {0}")]
-    Fleet(#[from] crate::sinks::fleet::bridge::BridgeError),
+    #[error(transparent)]
+    Sinks(#[from] SinkStartError),
     #[error("cannot start the {what} thread: {source}")]
     ThreadSpawn {
         what: &'static str,
@@ -139,25 +131,22 @@ pub const SINK_QUEUE: usize = 1024;
 /// Length of a simulated sensor's block, in seconds of sample time.
 const SIM_BLOCK_S: f64 = 0.1;
 
-/// Runs until `shutdown` resolves, the duration is reached or every source has ended; what
-/// the operator should know goes to `events`.
+/// Runs until `shutdown` resolves, the duration is reached or every source has ended, into the
+/// sinks of `plan` ([`SinkPlan::run`]); what the operator should know goes to `events`.
 pub async fn run(
     config: Config,
     options: RunOptions,
-    mut sinks: Vec<Box<dyn Sink>>,
+    plan: SinkPlan,
     events: Events,
     shutdown: impl std::future::Future<Output = ()>,
 ) -> Result<RunSummary, RunError> {
-    // Everything that can refuse the start comes before the log, which is opened last: a
-    // refused start must not leave an empty log behind (one per restart, issue 32).
+    // Everything that can refuse the start comes before the log, which `assemble` opens last:
+    // a refused start must not leave an empty log behind (one per restart, issue 32).
     let state_dir = prepare_state_dir(&config)?;
     prepare_iox_root(&config, &events)?;
     let _locks = lock_data_dirs(&config, &events)?;
     let can_sources = open_can_sources(&config)?;
     let learned = load_learned(&config.twin)?;
-    let alerts = start_alerts(&config, &events)?;
-    // Wall time of sample 0: the log's time base, and the fleet bridge's.
-    let origin_ns = wall_clock_now_ns();
     // The learned state before the log, which records what the run started with.
     let (baselines, loaded) = load_baselines(&state_dir);
     match loaded {
@@ -165,32 +154,45 @@ pub async fn run(
         Ok(None) => events(DaemonEvent::NoState(state_dir.clone())),
         Err(problem) => events(DaemonEvent::State(problem)),
     }
-    let fleet = start_fleet(&config, origin_ns, &events)?;
-    sinks.push(Box::new(open_log(&config, origin_ns, &baselines, &events)?));
-    sinks.extend(fleet.map(|fleet| Box::new(fleet) as Box<dyn Sink>));
+    // Wall time of sample 0: the log's time base and the fleet bridge's; it also names the
+    // run, in the log's metadata and in every alert.
+    let origin_ns = wall_clock_now_ns();
+    let start = SinkStart {
+        run_id: origin_ns,
+        origin_ns,
+        baselines: &baselines,
+    };
+    let Sinks {
+        immediate,
+        queued,
+        alerts,
+    } = assemble(&config, plan, &start, &events)?;
     let _cpu_latency = cap_cpu_latency(&config, &events);
     let pipeline = Pipeline::new(
         &config,
         &baselines,
         learned.clone().map(|m| m as Arc<dyn Witness>),
-    );
+    )
+    .with_run_id(origin_ns);
 
     let (input_tx, input_rx) = async_mpsc::channel::<Arrived>(ANALYSIS_QUEUE);
-    let (sink_tx, sink_rx) = mpsc::sync_channel::<PipelineMessage>(SINK_QUEUE);
+    let (sink_tx, sink_rx) = mpsc::sync_channel::<SinkItem>(SINK_QUEUE);
     let (request_tx, request_rx) = twin_requests();
     // Two messages per request at most (the twin's fit, the HW model's).
     let (fit_tx, fit_rx) = mpsc::sync_channel::<PipelineMessage>(2 * config.channel_count() + 2);
     let (status_tx, status_rx) = watch::channel(pipeline.status());
 
-    let sink = spawn("sink", move || sink_thread(sinks, &sink_rx))?;
+    let sink = spawn("sink", move || sink_thread(queued, &sink_rx))?;
     let worker = TwinWorker::new(&config.twin, learned);
     let refit = spawn("twin", move || refit_thread(worker, &request_rx, &fit_tx))?;
     let analysis = AnalysisThread {
         pipeline,
-        alerts,
+        sinks: SinkEnds {
+            immediate,
+            queue: sink_tx,
+            pending: Vec::new(),
+        },
         inputs: input_rx,
-        sinks: sink_tx,
-        for_sinks: Vec::new(),
         twin_requests: Some(request_tx),
         fits: fit_rx,
         status: status_tx,
@@ -240,15 +242,17 @@ pub async fn run(
     let analysis = join("analysis", analysis)?;
     let twin_fits = join("twin re-fit", refit)?;
     let (flags, messages) = join("sink", sink)??;
+    analysis.immediate_sinks?;
     let channels = status_rx.borrow().clone();
+    let alerts = alerts.as_ref().and_then(|slot| slot.get().copied());
     Ok(RunSummary {
         channels,
         flags,
         messages,
         twin_fits,
         twin_requests_skipped: analysis.requests_skipped,
-        alerts_published: analysis.alerts.map_or(0, |s| s.published),
-        alerts_failed: analysis.alerts.map_or(0, |s| s.failed),
+        alerts_published: alerts.map_or(0, |s| s.published),
+        alerts_failed: alerts.map_or(0, |s| s.failed),
     })
 }
 
@@ -328,96 +332,6 @@ fn lock_data_dirs(config: &Config, events: &Events) -> Result<Vec<DirLock>, RunE
     Ok(locks)
 }
 
-/// Recovers what a crash left in the log directory and opens the log, sample 0 at now, the
-/// run starting with `baselines`.
-fn open_log(
-    config: &Config,
-    origin_ns: u64,
-    baselines: &BTreeMap<ChannelId, Baseline>,
-    events: &Events,
-) -> Result<McapSink, RunError> {
-    let (log, recovered) = McapSink::for_config(config, origin_ns, baselines)?;
-    let log = {
-        let events = events.clone();
-        log.on_notice(move |notice| events(DaemonEvent::Log(notice.clone())))
-    };
-    for report in recovered {
-        events(DaemonEvent::Recovered(report));
-    }
-    if let Some(path) = log.current_path() {
-        events(DaemonEvent::LoggingTo(path.to_path_buf()));
-    }
-    Ok(log)
-}
-
-/// The fleet bridge of `[fleet]`, when it is on; its notices become [`DaemonEvent::Fleet`].
-fn start_fleet(
-    config: &Config,
-    origin_ns: u64,
-    events: &Events,
-) -> Result<Option<FleetSink>, RunError> {
-    let events = events.clone();
-    let notices = std::sync::Arc::new(move |line| events(DaemonEvent::Fleet(line)));
-    Ok(FleetSink::start(config, origin_ns, notices)?)
-}
-
-/// The alert service `outputs.alerts_service` under `outputs.iceoryx2_root`.
-#[cfg(feature = "shm")]
-type AlertSink = crate::sinks::alerts::AlertSink;
-
-#[cfg(feature = "shm")]
-fn start_alerts(config: &Config, events: &Events) -> Result<Option<AlertSink>, RunError> {
-    let iox = crate::iox::IoxSettings::with_root(&config.outputs.iceoryx2_root);
-    // What a killed bearingd (or a killed publisher) left under this root, removed and said
-    // before this one creates its nodes.
-    match crate::iox::remove_dead_nodes(&iox) {
-        Ok(dead) => {
-            for node in dead {
-                events(DaemonEvent::DeadIoxNode {
-                    root: config.outputs.iceoryx2_root.clone(),
-                    node,
-                });
-            }
-        }
-        Err(e) => events(DaemonEvent::DeadIoxNodesUnknown(e.to_string())),
-    }
-    let alerts = AlertSink::start(config, iox, wall_clock_now_ns())?;
-    events(DaemonEvent::AlertsOn {
-        service: config.outputs.alerts_service.clone(),
-        root: config.outputs.iceoryx2_root.clone(),
-        reopened: alerts.reopened(),
-    });
-    Ok(Some(alerts))
-}
-
-/// Without iceoryx2 (the `shm` feature) there is no alert service; flags still go to the log.
-#[cfg(not(feature = "shm"))]
-enum AlertSink {}
-
-#[cfg(not(feature = "shm"))]
-impl AlertSink {
-    fn observe(
-        &mut self,
-        _: &PipelineMessage,
-        _: u64,
-        _: &mut impl FnMut(std::convert::Infallible),
-    ) {
-        match *self {}
-    }
-    fn note_twin(&mut self, _: &crate::messages::TwinMessage) {
-        match *self {}
-    }
-    fn finish(self) -> PublisherSummary {
-        match self {}
-    }
-}
-
-#[cfg(not(feature = "shm"))]
-fn start_alerts(_config: &Config, events: &Events) -> Result<Option<AlertSink>, RunError> {
-    events(DaemonEvent::NoAlertService);
-    Ok(None)
-}
-
 /// Starts a named thread of the daemon.
 fn spawn<T: Send + 'static>(
     what: &'static str,
@@ -437,18 +351,62 @@ fn join<T>(what: &'static str, thread: std::thread::JoinHandle<T>) -> Result<T, 
 /// What the analysis thread reports when it ends.
 struct AnalysisSummary {
     requests_skipped: u64,
-    alerts: Option<PublisherSummary>,
+    /// How the immediate sinks finished.
+    immediate_sinks: Result<(), SinkError>,
 }
 
-/// The analysis thread's state: the pipeline, the alert sink and its ends of the queues.
+/// The analysis thread's ends toward the sinks: the immediate sinks (the alert publisher),
+/// handed each output as it comes, and the sink queue, handed an input's outputs once they are
+/// all out (a send wakes the sink thread: not before an alert has left).
+struct SinkEnds {
+    immediate: Vec<Box<dyn Sink>>,
+    queue: mpsc::SyncSender<SinkItem>,
+    /// The current input's outputs, for the queue. A few per input; reused.
+    pending: Vec<SinkItem>,
+}
+
+impl SinkEnds {
+    /// The next outputs are those of an input its source completed at `wall_ns`.
+    fn arrived(&mut self, wall_ns: u64) {
+        for sink in &mut self.immediate {
+            sink.arrived(wall_ns);
+        }
+    }
+
+    /// To the immediate sinks now, to the queue at the next [`flush`](Self::flush).
+    fn take(&mut self, item: SinkItem) {
+        for sink in &mut self.immediate {
+            item.deliver_to(sink.as_mut());
+        }
+        self.pending.push(item);
+    }
+
+    /// Hands what was taken to the sink queue, in order (waits while the queue is full).
+    fn flush(&mut self) {
+        for item in self.pending.drain(..) {
+            let _ = self.queue.send(item);
+        }
+    }
+
+    /// Finishes the immediate sinks (the queued ones finish on the sink thread, once the
+    /// queue closes with this).
+    fn finish(mut self) -> Result<(), SinkError> {
+        self.flush();
+        let mut first_error = None;
+        for sink in &mut self.immediate {
+            if let Err(e) = sink.finish() {
+                first_error.get_or_insert(e);
+            }
+        }
+        first_error.map_or(Ok(()), Err)
+    }
+}
+
+/// The analysis thread's state: the pipeline, the immediate sinks and its ends of the queues.
 struct AnalysisThread {
     pipeline: Pipeline,
-    alerts: Option<AlertSink>,
+    sinks: SinkEnds,
     inputs: async_mpsc::Receiver<Arrived>,
-    sinks: mpsc::SyncSender<PipelineMessage>,
-    /// The current input's messages, handed to the sink queue once its alerts are out (a
-    /// send wakes the sink thread: not before an alert). A few per input; reused.
-    for_sinks: Vec<PipelineMessage>,
     /// `None` once the inputs have ended (closing the re-fit queue).
     twin_requests: Option<TwinRequests>,
     fits: mpsc::Receiver<PipelineMessage>,
@@ -485,8 +443,8 @@ impl AnalysisThread {
         }
     }
 
-    /// One input through the pipeline; its outputs to the alerts and the re-fit as they come,
-    /// then, in their order, to the sinks.
+    /// One input through the pipeline; its outputs to the immediate sinks and the re-fit as
+    /// they come, then, in their order, to the sink queue.
     fn analyse(&mut self, arrived: Arrived) {
         let Arrived { input, wall_ns } = arrived;
         self.deliver(wall_ns, |pipeline, mut out| {
@@ -498,25 +456,16 @@ impl AnalysisThread {
     fn deliver(&mut self, wall_ns: u64, step: impl FnOnce(&mut Pipeline, &mut dyn FnMut(Output))) {
         let AnalysisThread {
             pipeline,
-            alerts,
-            for_sinks,
+            sinks,
             twin_requests,
             requests_skipped,
             events,
             ..
         } = self;
+        sinks.arrived(wall_ns);
         step(pipeline, &mut |output| match output {
-            Output::Message(message) => {
-                if let Some(alerts) = alerts.as_mut() {
-                    alerts.observe(&message, wall_ns, &mut |failed| {
-                        #[cfg(feature = "shm")]
-                        events(DaemonEvent::AlertFailed(failed));
-                        #[cfg(not(feature = "shm"))]
-                        let _ = (failed, &events);
-                    });
-                }
-                for_sinks.push(message);
-            }
+            Output::Message(message) => sinks.take(SinkItem::Message(message)),
+            Output::Alert(alert) => sinks.take(SinkItem::Alert(alert)),
             Output::Twin(request) => {
                 let (channel, end_sample) = (request.channel.clone(), request.end_sample);
                 let dropped = match twin_requests.as_ref() {
@@ -533,22 +482,17 @@ impl AnalysisThread {
                 }
             }
         });
-        for message in self.for_sinks.drain(..) {
-            let _ = self.sinks.send(message);
-        }
+        sinks.flush();
     }
 
-    /// A message of the re-fit thread: a twin's fit into the channel's status and the alerts;
-    /// every one to the sinks.
+    /// A message of the re-fit thread: a twin's fit into the pipeline (the channel's status,
+    /// the confidence of later alerts); every one to the sinks.
     fn take_fit(&mut self, fit: PipelineMessage) {
         if let PipelineMessage::Twin(twin) = &fit {
-            self.pipeline
-                .note_twin(&twin.channel, twin.hypothesis, twin.error);
-            if let Some(alerts) = self.alerts.as_mut() {
-                alerts.note_twin(twin);
-            }
+            self.pipeline.note_twin(twin);
         }
-        let _ = self.sinks.send(fit);
+        self.sinks.take(SinkItem::Message(fit));
+        self.sinks.flush();
     }
 
     /// The inputs have ended: the channels' last verdict on the evidence not yet analysed (as a
@@ -572,7 +516,7 @@ impl AnalysisThread {
         }
         AnalysisSummary {
             requests_skipped: self.requests_skipped,
-            alerts: self.alerts.map(AlertSink::finish),
+            immediate_sinks: self.sinks.finish(),
         }
     }
 }
@@ -599,22 +543,24 @@ fn refit_thread(
     made
 }
 
-/// The sink thread: every message to every sink, then finishes them. Returns the flag changes
-/// and the number of messages.
+/// The sink thread: every message and alert to every queued sink, then finishes them. Returns
+/// the flag changes and the number of messages (alerts not counted).
 fn sink_thread(
     mut sinks: Vec<Box<dyn Sink>>,
-    messages: &mpsc::Receiver<PipelineMessage>,
+    items: &mpsc::Receiver<SinkItem>,
 ) -> Result<(Vec<FlagMessage>, u64), SinkError> {
     crate::pipeline::priority::idle_this_thread();
     let mut flags = Vec::new();
     let mut count = 0u64;
-    while let Ok(message) = messages.recv() {
-        count += 1;
-        if let PipelineMessage::Flag(flag) = &message {
-            flags.push(flag.clone());
+    while let Ok(item) = items.recv() {
+        if let SinkItem::Message(message) = &item {
+            count += 1;
+            if let PipelineMessage::Flag(flag) = message {
+                flags.push(flag.clone());
+            }
         }
         for sink in sinks.iter_mut() {
-            sink.write(&message);
+            item.deliver_to(sink.as_mut());
         }
     }
     let mut first_error = None;
@@ -925,5 +871,157 @@ async fn report_status(
         ticker.tick().await;
         let board = status.borrow().clone();
         events(DaemonEvent::Status(board));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::messages::{AlertMessage, AlertState, AlertSubject, ChannelId, FaultKind};
+    use crate::messages::{FlagLevel, HealthKind, HealthMessage};
+    use std::sync::Mutex;
+
+    /// What an immediate sink saw: each item's kind, the wall time it was told last, and
+    /// whether the sink queue held anything yet.
+    type Seen = Arc<Mutex<Vec<(&'static str, Option<u64>, bool)>>>;
+
+    /// An immediate sink that looks into the sink queue as it is handed each item.
+    struct Watching {
+        queue: Arc<Mutex<mpsc::Receiver<SinkItem>>>,
+        arrived: Option<u64>,
+        seen: Seen,
+    }
+
+    impl Watching {
+        fn note(&mut self, kind: &'static str) {
+            let queued = self.queue.lock().unwrap().try_recv().is_ok();
+            self.seen.lock().unwrap().push((kind, self.arrived, queued));
+        }
+    }
+
+    impl Sink for Watching {
+        fn write(&mut self, _: &PipelineMessage) {
+            self.note("message");
+        }
+        fn alert(&mut self, _: &AlertMessage) {
+            self.note("alert");
+        }
+        fn arrived(&mut self, wall_time_ns: u64) {
+            self.arrived = Some(wall_time_ns);
+        }
+        fn finish(&mut self) -> Result<(), SinkError> {
+            Ok(())
+        }
+    }
+
+    /// An analysis thread on the embedded default whose one immediate sink is `immediate`.
+    fn analysis_thread(
+        immediate: Box<dyn Sink>,
+        queue: mpsc::SyncSender<SinkItem>,
+    ) -> AnalysisThread {
+        let config = Config::default_embedded().unwrap();
+        let pipeline = Pipeline::new(&config, &Default::default(), None);
+        let (_, inputs) = async_mpsc::channel(1);
+        let (_, fits) = mpsc::sync_channel(1);
+        let (status, _) = watch::channel(pipeline.status());
+        AnalysisThread {
+            pipeline,
+            sinks: SinkEnds {
+                immediate: vec![immediate],
+                queue,
+                pending: Vec::new(),
+            },
+            inputs,
+            twin_requests: None,
+            fits,
+            status,
+            requests_skipped: 0,
+            state_dir: bearingd_testdata::scratch_dir("analysis-thread"),
+            state_every: Duration::MAX,
+            state_saved: std::time::Instant::now(),
+            events: super::super::ignore_events(),
+        }
+    }
+
+    fn channel() -> ChannelId {
+        ChannelId {
+            sensor: "motor-de".into(),
+            axis: "radial".into(),
+        }
+    }
+
+    #[test]
+    fn the_immediate_sink_has_the_alert_before_the_sink_queue_has_anything() {
+        let (queue, queued) = mpsc::sync_channel(SINK_QUEUE);
+        let queued = Arc::new(Mutex::new(queued));
+        let seen = Seen::default();
+        let watching = Watching {
+            queue: queued.clone(),
+            arrived: None,
+            seen: seen.clone(),
+        };
+        let mut thread = analysis_thread(Box::new(watching), queue);
+        let health = PipelineMessage::Health(HealthMessage {
+            channel: channel(),
+            end_sample: 2560,
+            kind: HealthKind::Gap,
+            stage: None,
+            detail: String::new(),
+        });
+        let alert = AlertMessage {
+            sequence: 1,
+            run_id: 9,
+            channel: channel(),
+            end_sample: 2560,
+            sample_rate_hz: 25_600.0,
+            subject: AlertSubject::Fault(FaultKind::OuterRace),
+            state: AlertState::Raised,
+            severity: FlagLevel::Watch,
+            previous_severity: FlagLevel::Ok,
+            score: 30.0,
+            confidence: 0.9,
+            fault_frequency_hz: Some(107.0),
+            twin_error: None,
+        };
+        // An input whose source completed it at 42 gives a message, then an alert.
+        thread.deliver(42, |_, out| {
+            out(Output::Message(health.clone()));
+            out(Output::Alert(alert.clone()));
+        });
+        assert_eq!(
+            *seen.lock().unwrap(),
+            [("message", Some(42), false), ("alert", Some(42), false)]
+        );
+        // Then the queue has both, in order.
+        let queued = queued.lock().unwrap();
+        assert_eq!(queued.try_recv(), Ok(SinkItem::Message(health)));
+        assert_eq!(queued.try_recv(), Ok(SinkItem::Alert(alert)));
+        assert!(queued.try_recv().is_err());
+    }
+
+    /// An immediate sink whose finish fails.
+    struct Failing;
+
+    impl Sink for Failing {
+        fn write(&mut self, _: &PipelineMessage) {}
+        fn finish(&mut self) -> Result<(), SinkError> {
+            Err(SinkError {
+                sink: "failing",
+                count: 1,
+                first: "it could not close".into(),
+            })
+        }
+    }
+
+    #[test]
+    fn the_stop_finishes_the_immediate_sinks_and_reports_their_failure() {
+        let (queue, queued) = mpsc::sync_channel(SINK_QUEUE);
+        let thread = analysis_thread(Box::new(Failing), queue);
+        let summary = thread.stop();
+        let failed = summary.immediate_sinks.unwrap_err();
+        assert_eq!(failed.sink, "failing");
+        // The sink queue is closed: the sink thread ends.
+        while queued.try_recv().is_ok() {}
+        assert_eq!(queued.try_recv(), Err(mpsc::TryRecvError::Disconnected));
     }
 }

@@ -10,9 +10,14 @@
 //! their results used a fixed sample-time delay ([`band_delay_s`]) after they started, so the
 //! outputs still depend only on the inputs.
 //!
-//! [`Sink`] is the seam to the sinks: the pipeline's messages go to whatever implements it
-//! (the MCAP log, the command line's flag printer), and the pipeline knows none of them.
+//! Alerts are decided here, once ([`alerts`]): each flag change is followed at once by its
+//! [`Output::Alert`], numbered and weighed, for every sink that wants it.
+//!
+//! [`Sink`] is the seam to the sinks: the pipeline's messages and alerts go to whatever
+//! implements it (the MCAP log, the alert publisher, the fleet bridge, the command line's flag
+//! printer), and the pipeline knows none of them.
 
+pub mod alerts;
 pub mod bands;
 pub mod priority;
 pub mod refit;
@@ -20,7 +25,7 @@ mod sink;
 pub mod twin_queue;
 
 pub use refit::{load_learned, TwinWorker};
-pub use sink::{Sink, SinkError};
+pub use sink::{Sink, SinkError, SinkItem};
 
 use crate::analysis::agreement::Witness;
 use crate::analysis::flags::FlagSettings;
@@ -31,11 +36,12 @@ use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
 use crate::config::{Config, SensorConfig, Speed};
 use crate::messages::{
-    ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage, HealthStage,
-    IndicatorsMessage, IngestMessage, IsoZone, PipelineMessage, RawBlock, SpectrumMessage,
-    SpeedMessage, SpeedSource, TrendMessage, VelocityFlagMessage, VelocityMessage,
-    VELOCITY_FLAG_NAME,
+    AlertMessage, ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage,
+    HealthStage, IndicatorsMessage, IngestMessage, IsoZone, PipelineMessage, RawBlock,
+    SpectrumMessage, SpeedMessage, SpeedSource, TrendMessage, TwinMessage, VelocityFlagMessage,
+    VelocityMessage, VELOCITY_FLAG_NAME,
 };
+use alerts::{history_size_for, pass_on, AlertTracker};
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -105,6 +111,8 @@ fn flagged_fault(monitor: &ChannelMonitor) -> Option<FaultKind> {
 #[derive(Debug, Clone)]
 pub enum Output {
     Message(PipelineMessage),
+    /// The alert of the flag change just emitted (and any repeats it causes).
+    Alert(AlertMessage),
     Twin(TwinRequest),
 }
 
@@ -172,6 +180,7 @@ pub struct Pipeline {
     spectrum_every_s: f64,
     twin_period_s: f64,
     twin_window_s: f64,
+    alerts: AlertTracker,
 }
 
 /// The monitor settings of one sensor: the config's durations turned into samples.
@@ -383,7 +392,19 @@ impl Pipeline {
             spectrum_every_s: SPECTRUM_EVERY_S,
             twin_period_s: config.twin.refit_period_s,
             twin_window_s: config.twin.window_s,
+            alerts: AlertTracker::new(
+                0,
+                history_size_for(turns),
+                &config.analysis,
+                config.sample_rates(),
+            ),
         }
+    }
+
+    /// Names the run its alerts belong to (their `run_id`; 0 unless named).
+    pub fn with_run_id(mut self, run_id: u64) -> Self {
+        self.alerts.set_run_id(run_id);
+        self
     }
 
     /// Channels that sent blocks the config does not know, with the number of blocks skipped.
@@ -406,16 +427,20 @@ impl Pipeline {
             .collect()
     }
 
-    /// Records the twin's latest result in the channel's status.
-    pub fn note_twin(&mut self, channel: &ChannelId, hypothesis: FaultKind, error: f64) {
-        if let Some(c) = self.channels.get_mut(channel) {
-            c.status.twin_hypothesis = Some(hypothesis);
-            c.status.twin_error = Some(error);
+    /// Takes a twin fit made for a request of this pipeline: into the channel's status, and
+    /// into the confidence of its later alerts.
+    pub fn note_twin(&mut self, fit: &TwinMessage) {
+        if let Some(c) = self.channels.get_mut(&fit.channel) {
+            c.status.twin_hypothesis = Some(fit.hypothesis);
+            c.status.twin_error = Some(fit.error);
         }
+        self.alerts.note_twin(fit);
     }
 
     /// Handles one input; unknown channels are reported, not analysed.
     pub fn handle(&mut self, input: Input, out: &mut impl FnMut(Output)) {
+        let alerts = &mut self.alerts;
+        let out = &mut |output| pass_on(alerts, output, out);
         match input {
             Input::Samples {
                 channel,
@@ -489,8 +514,8 @@ impl Pipeline {
                 }
             }
             Input::Ingest(message) => out(Output::Message(PipelineMessage::Ingest(message))),
-            Input::SensorLost { sensor } => self.sensor_event(&sensor, true, out),
-            Input::SensorBack { sensor } => self.sensor_event(&sensor, false, out),
+            Input::SensorLost { sensor } => sensor_event(&mut self.channels, &sensor, true, out),
+            Input::SensorBack { sensor } => sensor_event(&mut self.channels, &sensor, false, out),
             Input::Restart {
                 channel,
                 first_sample,
@@ -515,36 +540,40 @@ impl Pipeline {
     /// on the verdict of everything it saw.
     pub fn finish(&mut self, out: &mut impl FnMut(Output)) {
         let spectrum_every_s = self.spectrum_every_s;
+        let alerts = &mut self.alerts;
+        let out = &mut |output| pass_on(alerts, output, out);
         for (id, c) in &mut self.channels {
             c.drive(id, spectrum_every_s, out, |monitor, mut on_event| {
                 monitor.finish(&mut on_event)
             });
         }
     }
+}
 
-    fn sensor_event(&mut self, sensor: &str, lost: bool, out: &mut impl FnMut(Output)) {
-        for (id, c) in self
-            .channels
-            .iter_mut()
-            .filter(|(id, _)| id.sensor == sensor)
-        {
-            c.status.sensor_lost = lost;
-            out(Output::Message(PipelineMessage::Health(HealthMessage {
-                channel: id.clone(),
-                end_sample: c.monitor.next_sample(),
-                kind: if lost {
-                    HealthKind::Lost
-                } else {
-                    HealthKind::Back
-                },
-                stage: None,
-                detail: if lost {
-                    "no frame from the sensor within its timeout".into()
-                } else {
-                    "the sensor sends again".into()
-                },
-            })));
-        }
+/// A sensor lost or back: a health message for each of its channels.
+fn sensor_event(
+    channels: &mut BTreeMap<ChannelId, Channel>,
+    sensor: &str,
+    lost: bool,
+    out: &mut impl FnMut(Output),
+) {
+    for (id, c) in channels.iter_mut().filter(|(id, _)| id.sensor == sensor) {
+        c.status.sensor_lost = lost;
+        out(Output::Message(PipelineMessage::Health(HealthMessage {
+            channel: id.clone(),
+            end_sample: c.monitor.next_sample(),
+            kind: if lost {
+                HealthKind::Lost
+            } else {
+                HealthKind::Back
+            },
+            stage: None,
+            detail: if lost {
+                "no frame from the sensor within its timeout".into()
+            } else {
+                "the sensor sends again".into()
+            },
+        })));
     }
 }
 

@@ -8,7 +8,7 @@
 //! to the narrowest so there is no padding to get wrong.
 
 use crate::config::MAX_ID_LEN;
-use crate::messages::{FaultKind, FlagLevel};
+use crate::messages::{AlertMessage, AlertSubject, FaultKind, FlagLevel};
 #[cfg(feature = "shm")]
 use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
@@ -19,56 +19,10 @@ pub const ALERT_VERSION: u32 = 1;
 /// Bytes for a sensor id or an axis name: the config's longest id (ASCII), NUL-padded.
 pub const NAME_BYTES: usize = MAX_ID_LEN;
 
-/// What happened to the alert of one (channel, fault).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-#[repr(u8)]
-pub enum AlertState {
-    /// The fault's flag left `ok`.
-    Raised = 1,
-    /// Its severity went up (watch → alarm).
-    Escalated = 2,
-    /// Its severity went down but the flag is still up (alarm → watch).
-    Relaxed = 3,
-    /// The flag is back to `ok`: the alert is no longer active.
-    Cleared = 4,
-    /// Nothing changed: an active alert sent again so that it stays in the service's history
-    /// for subscribers that connect later.
-    Repeated = 5,
-}
+pub use crate::messages::AlertState;
 
-impl AlertState {
-    pub const ALL: [AlertState; 5] = [
-        AlertState::Raised,
-        AlertState::Escalated,
-        AlertState::Relaxed,
-        AlertState::Cleared,
-        AlertState::Repeated,
-    ];
-
-    pub fn name(self) -> &'static str {
-        match self {
-            AlertState::Raised => "raised",
-            AlertState::Escalated => "escalated",
-            AlertState::Relaxed => "relaxed",
-            AlertState::Cleared => "cleared",
-            AlertState::Repeated => "repeated",
-        }
-    }
-
-    /// The state of a flag change from `from` to `to`.
-    pub fn of_change(from: FlagLevel, to: FlagLevel) -> AlertState {
-        match (from, to) {
-            (FlagLevel::Ok, _) => AlertState::Raised,
-            (_, FlagLevel::Ok) => AlertState::Cleared,
-            _ if to > from => AlertState::Escalated,
-            _ => AlertState::Relaxed,
-        }
-    }
-
-    fn from_code(code: u8) -> Option<AlertState> {
-        AlertState::ALL.into_iter().find(|s| *s as u8 == code)
-    }
+fn state_of_code(code: u8) -> Option<AlertState> {
+    AlertState::ALL.into_iter().find(|s| *s as u8 == code)
 }
 
 /// Code of a fault kind in [`Alert::fault`]: 1 outer race, 2 inner race, 3 ball, 4 cage.
@@ -84,6 +38,14 @@ pub fn fault_code(fault: FaultKind) -> u8 {
 /// Code in [`Alert::fault`] of the ISO velocity zone flag (watch in zone C, alarm in zone D):
 /// `score` is then the velocity RMS in mm/s, `fault_frequency_hz` and `twin_error` NaN.
 pub const ISO_ZONE_CODE: u8 = 5;
+
+/// Code in [`Alert::fault`] of the flag an alert is about.
+pub fn subject_code(subject: AlertSubject) -> u8 {
+    match subject {
+        AlertSubject::Fault(fault) => fault_code(fault),
+        AlertSubject::IsoZone => ISO_ZONE_CODE,
+    }
+}
 
 /// The wire name of a code of [`Alert::fault`]: a fault kind's (`outer_race`, …) or
 /// `iso_zone`.
@@ -210,6 +172,29 @@ pub struct AlertView {
 }
 
 impl Alert {
+    /// The record of the pipeline's `alert`, sent at `wall_time_ns` (when the source completed
+    /// the block that decided it); a missing frequency or twin error is NaN.
+    pub fn of_message(alert: &AlertMessage, wall_time_ns: u64) -> Alert {
+        Alert {
+            sequence: alert.sequence,
+            run_id: alert.run_id,
+            end_sample: alert.end_sample,
+            wall_time_ns,
+            sample_rate_hz: alert.sample_rate_hz,
+            fault_frequency_hz: alert.fault_frequency_hz.unwrap_or(f64::NAN),
+            score: alert.score,
+            confidence: alert.confidence,
+            twin_error: alert.twin_error.unwrap_or(f64::NAN),
+            version: ALERT_VERSION,
+            state: alert.state as u8,
+            fault: subject_code(alert.subject),
+            severity: severity_code(alert.severity),
+            previous_severity: severity_code(alert.previous_severity),
+            sensor: name_field(&alert.channel.sensor),
+            axis: name_field(&alert.channel.axis),
+        }
+    }
+
     /// Decodes the codes; refuses other layout versions and unknown codes.
     pub fn view(&self) -> Result<AlertView, AlertDecodeError> {
         if self.version != ALERT_VERSION {
@@ -220,7 +205,7 @@ impl Alert {
             field,
             code,
         };
-        let state = AlertState::from_code(self.state).ok_or(bad("state", self.state))?;
+        let state = state_of_code(self.state).ok_or(bad("state", self.state))?;
         let fault = subject_of_code(self.fault).ok_or(bad("fault", self.fault))?;
         let severity = severity_of_code(self.severity).ok_or(bad("severity", self.severity))?;
         let previous = severity_of_code(self.previous_severity)
@@ -348,6 +333,57 @@ mod tests {
         assert_eq!(bad.view(), Err(AlertDecodeError::Version(2)));
         let bad = Alert { fault: 9, ..alert };
         assert!(bad.view().is_err());
+    }
+
+    #[test]
+    fn a_pipeline_alert_becomes_the_record_with_the_wall_time_stamped() {
+        let message = AlertMessage {
+            sequence: 3,
+            run_id: 77,
+            channel: crate::messages::ChannelId {
+                sensor: "motor-de".into(),
+                axis: "radial".into(),
+            },
+            end_sample: 51_200,
+            sample_rate_hz: 25_600.0,
+            subject: AlertSubject::Fault(FaultKind::InnerRace),
+            state: AlertState::Escalated,
+            severity: FlagLevel::Alarm,
+            previous_severity: FlagLevel::Watch,
+            score: 55.0,
+            confidence: 0.8,
+            fault_frequency_hz: Some(162.0),
+            twin_error: None,
+        };
+        let alert = Alert::of_message(&message, 123);
+        assert_eq!((alert.wall_time_ns, alert.version), (123, ALERT_VERSION));
+        assert!(alert.twin_error.is_nan());
+        let view = alert.view().unwrap();
+        assert_eq!(
+            (view.sequence, view.run_id, view.end_sample),
+            (3, 77, 51_200)
+        );
+        assert_eq!(
+            (view.sensor.as_str(), view.axis.as_str()),
+            ("motor-de", "radial")
+        );
+        assert_eq!(
+            (view.fault, view.state),
+            ("inner_race", AlertState::Escalated)
+        );
+        assert_eq!((view.severity, view.previous_severity), ("alarm", "watch"));
+        assert_eq!((view.score, view.confidence), (55.0, 0.8));
+        assert_eq!((view.fault_frequency_hz, view.sample_time_s), (162.0, 2.0));
+        let zone = Alert::of_message(
+            &AlertMessage {
+                subject: AlertSubject::IsoZone,
+                fault_frequency_hz: None,
+                ..message
+            },
+            0,
+        );
+        assert_eq!(zone.fault, ISO_ZONE_CODE);
+        assert!(zone.fault_frequency_hz.is_nan());
     }
 
     #[test]

@@ -4,16 +4,18 @@
 //!
 //! On the daemon's sink thread it turns each [`PipelineMessage`] into an [`Observation`]: the
 //! channel becomes a device index, the sample position a time in milliseconds since the epoch
-//! (`origin + sample / fs`, the mapping of the MCAP log), and a flag change gets the
-//! confidence the alert service would give it (the same [`AlertTracker`] rule). Raw samples,
-//! spectra, speed frames' bookkeeping and ingest counters do not leave the box.
+//! (`origin + sample / fs`, the mapping of the MCAP log). A fault flag's change is taken from
+//! the pipeline's alert of it, which carries the confidence the alert service publishes
+//! (decided once, in `pipeline::alerts`). Raw samples, spectra, speed frames' bookkeeping and
+//! ingest counters do not leave the box.
 
 use super::bridge::{self, BridgeError, BridgeHandle, Notices};
 use super::metrics::{device_id, Observation, Observed};
 use crate::config::Config;
-use crate::messages::{ChannelId, HealthKind, PipelineMessage};
+use crate::messages::{
+    AlertMessage, AlertState, AlertSubject, ChannelId, HealthKind, PipelineMessage,
+};
 use crate::pipeline::{Sink, SinkError};
-use crate::sinks::alerts::{AlertState, AlertTracker};
 use std::collections::HashMap;
 
 /// The fleet bridge as a sink of `bearingd run`.
@@ -22,7 +24,6 @@ pub struct FleetSink {
     channels: HashMap<ChannelId, usize>,
     rates: HashMap<String, f64>,
     origin_ns: u64,
-    tracker: AlertTracker,
     /// The bridge thread is gone (said once).
     gone: bool,
     notices: Notices,
@@ -65,14 +66,11 @@ impl FleetSink {
             fleet.queue_dir.display()
         ));
         let handle = bridge::start(fleet, devices, notices.clone())?;
-        // The tracker's history size only matters for iceoryx2 repeats, which are ignored here.
-        let tracker = AlertTracker::new(origin_ns, 16, &config.analysis, rates.clone());
         Ok(Some(FleetSink {
             handle: Some(handle),
             channels,
             rates,
             origin_ns,
-            tracker,
             gone: false,
             notices,
         }))
@@ -83,7 +81,28 @@ impl FleetSink {
         (self.origin_ns + (sample as f64 / fs * 1e9) as u64) / 1_000_000
     }
 
-    fn observation(&mut self, message: &PipelineMessage) -> Option<Observation> {
+    /// The observation of a fault flag's change: its alert (a repeat changes nothing; the
+    /// velocity zone goes as the zone metric, from its readings).
+    fn flag_observation(&self, alert: &AlertMessage) -> Option<Observation> {
+        let AlertSubject::Fault(fault) = alert.subject else {
+            return None;
+        };
+        if alert.state == AlertState::Repeated {
+            return None;
+        }
+        Some(Observation {
+            device: *self.channels.get(&alert.channel)?,
+            at_ms: self.at_ms(&alert.channel, alert.end_sample),
+            what: Observed::Flag {
+                fault,
+                level: alert.severity,
+                score: alert.score,
+                confidence: alert.confidence,
+            },
+        })
+    }
+
+    fn observation(&self, message: &PipelineMessage) -> Option<Observation> {
         let (channel, sample, what) = match message {
             PipelineMessage::Indicators(m) => (
                 &m.channel,
@@ -102,24 +121,6 @@ impl FleetSink {
                     ],
                 },
             ),
-            PipelineMessage::Flag(m) => {
-                let mut confidence = f64::NAN;
-                self.tracker.observe(message, 0, &mut |alert| {
-                    if alert.state != AlertState::Repeated as u8 {
-                        confidence = alert.confidence;
-                    }
-                });
-                (
-                    &m.channel,
-                    m.end_sample,
-                    Observed::Flag {
-                        fault: m.fault,
-                        level: m.to,
-                        score: m.score,
-                        confidence,
-                    },
-                )
-            }
             PipelineMessage::Health(m) => {
                 let what = match (m.kind, m.stage) {
                     (HealthKind::Stage, Some(stage)) => Observed::Stage(stage),
@@ -129,21 +130,18 @@ impl FleetSink {
                 };
                 (&m.channel, m.end_sample, what)
             }
-            PipelineMessage::Twin(m) => {
-                self.tracker.note_twin(m);
-                (
-                    &m.channel,
-                    m.end_sample,
-                    Observed::Twin {
-                        hypothesis: m.hypothesis,
-                        error: m.error,
-                        margin: m.margin,
-                        errors: [m.error_outer_race, m.error_inner_race, m.error_ball],
-                        residual_energy_ratio: m.residual_energy_ratio,
-                        residual_peak_hz: m.residual_peak_hz,
-                    },
-                )
-            }
+            PipelineMessage::Twin(m) => (
+                &m.channel,
+                m.end_sample,
+                Observed::Twin {
+                    hypothesis: m.hypothesis,
+                    error: m.error,
+                    margin: m.margin,
+                    errors: [m.error_outer_race, m.error_inner_race, m.error_ball],
+                    residual_energy_ratio: m.residual_energy_ratio,
+                    residual_peak_hz: m.residual_peak_hz,
+                },
+            ),
             PipelineMessage::Hw(m) => (
                 &m.channel,
                 m.end_sample,
@@ -171,16 +169,14 @@ impl FleetSink {
                     velocity_mm_s: m.rms_mm_s,
                 },
             ),
-            // The zone flag follows the zone (the zone metric changes first, and at once).
+            // The zone flag follows the zone (the zone metric changes first, and at once); a
+            // fault flag goes with its alert, which comes right after it.
             PipelineMessage::Raw(_)
             | PipelineMessage::Spectrum(_)
             | PipelineMessage::Ingest(_)
+            | PipelineMessage::Flag(_)
             | PipelineMessage::VelocityFlag(_) => return None,
         };
-        if let PipelineMessage::Indicators(_) = message {
-            // The tracker needs every window's scores for the confidence of the next flag.
-            self.tracker.observe(message, 0, &mut |_| {});
-        }
         Some(Observation {
             device: *self.channels.get(channel)?,
             at_ms: self.at_ms(channel, sample),
@@ -189,9 +185,9 @@ impl FleetSink {
     }
 }
 
-impl Sink for FleetSink {
-    fn write(&mut self, message: &PipelineMessage) {
-        let Some(observation) = self.observation(message) else {
+impl FleetSink {
+    fn send(&mut self, observation: Option<Observation>) {
+        let Some(observation) = observation else {
             return;
         };
         let Some(handle) = self.handle.as_ref() else {
@@ -203,6 +199,16 @@ impl Sink for FleetSink {
                 "fleet: the bridge thread has stopped; nothing more is published".into(),
             );
         }
+    }
+}
+
+impl Sink for FleetSink {
+    fn write(&mut self, message: &PipelineMessage) {
+        self.send(self.observation(message));
+    }
+
+    fn alert(&mut self, alert: &AlertMessage) {
+        self.send(self.flag_observation(alert));
     }
 
     fn finish(&mut self) -> Result<(), SinkError> {
