@@ -2,6 +2,7 @@
 //! ([`replay`]) put sources, the pipeline and sinks together, start and stop them.
 //!
 //! - [`run`]: threads, queues, shutdown and status of `bearingd run`.
+//! - `threads`: the analysis, re-fit and sink threads of `run`.
 //! - [`replay`]: logged raw samples through the same pipeline, into the same sinks.
 //! - [`sinks`]: which sinks a run or a replay gets, assembled in one place.
 //! - [`events`]: what the daemon tells its operator, as typed events for the caller to show
@@ -17,6 +18,7 @@ pub mod replay;
 pub mod run;
 pub mod sinks;
 pub mod state;
+mod threads;
 
 pub use events::{ignore_events, DaemonEvent, Events};
 pub use replay::{replay, BaselinesFrom, Gap, ReplayError, ReplayOptions, ReplaySummary, RunStart};
