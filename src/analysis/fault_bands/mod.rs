@@ -31,7 +31,7 @@ mod explain;
 mod floor;
 
 use explain::floor_comb;
-use floor::{median_of, subtract_running_median};
+use floor::{median_of, subtract_running_median, FloorScratch};
 
 /// Most harmonics a score may use.
 pub const MAX_HARMONICS: usize = 10;
@@ -201,9 +201,10 @@ pub struct FaultScorer {
     /// When scoring explained: the prepared excess with the bins the winner's comb explains at
     /// the floor (0).
     unexplained: Vec<f32>,
-    /// Scratch for the medians.
+    /// Scratch for the spread's medians.
     keys: Vec<i32>,
-    knots: Vec<f32>,
+    /// Scratch for the running-median floor.
+    floor: FloorScratch,
 }
 
 /// Relative half-width of a line's search window beside the slip (bearing-geometry and
@@ -231,7 +232,7 @@ impl FaultScorer {
                 .collect(),
             unexplained: Vec::with_capacity(spectrum_bins),
             keys: Vec::with_capacity(spectrum_bins),
-            knots: Vec::with_capacity(spectrum_bins),
+            floor: FloorScratch::default(),
         }
     }
 
@@ -290,7 +291,7 @@ impl FaultScorer {
             });
         }
         let FaultScorer {
-            slots, keys, knots, ..
+            slots, keys, floor, ..
         } = self;
         let prepared = &mut slots[slot];
         prepared.excess.clear();
@@ -303,7 +304,7 @@ impl FaultScorer {
         let tiny = f32::MIN_POSITIVE;
         excess.extend(amplitude.iter().map(|&a| a.max(tiny).ln()));
         let half = ((0.3 * lowest / bin_hz).round() as usize).max(8);
-        subtract_running_median(excess, half, keys, knots);
+        subtract_running_median(excess, half, floor);
         // The first bins hold the envelope's DC leakage.
         for e in excess.iter_mut().take(3) {
             *e = 0.0;
