@@ -33,6 +33,22 @@ pub(super) struct FloorScratch {
 }
 
 impl FloorScratch {
+    /// Scratch for spectra of up to `bins` bins, reserved at once so that the first spectrum
+    /// allocates nothing either.
+    pub(super) fn with_capacity(bins: usize) -> Self {
+        let words = bins.div_ceil(64);
+        FloorScratch {
+            keys: Vec::with_capacity(bins),
+            order: Vec::with_capacity(bins),
+            spare: Vec::with_capacity(bins),
+            rank: Vec::with_capacity(bins),
+            inside: Vec::with_capacity(words),
+            group_counts: Vec::with_capacity(words.div_ceil(GROUP_WORDS)),
+            // At most one knot per bin.
+            knots: Vec::with_capacity(bins),
+        }
+    }
+
     /// The median (upper one of an even count) of each knot window of `values` (see
     /// [`knot_windows`]) into `self.knots`.
     fn knot_medians(&mut self, values: &[f32], half: usize, stride: usize) {
@@ -57,7 +73,8 @@ impl FloorScratch {
                 self.set_inside(bin, true);
             }
             (start, end) = (lo, hi + 1);
-            let rank = self.nth_inside(((hi - lo + 1) / 2) as u32);
+            let len = hi - lo + 1;
+            let rank = self.nth_inside((len / 2) as u32);
             self.knots
                 .push(from_sort_key(self.keys[self.order[rank] as usize]));
         }

@@ -232,7 +232,7 @@ impl FaultScorer {
                 .collect(),
             unexplained: Vec::with_capacity(spectrum_bins),
             keys: Vec::with_capacity(spectrum_bins),
-            floor: FloorScratch::default(),
+            floor: FloorScratch::with_capacity(spectrum_bins),
         }
     }
 
