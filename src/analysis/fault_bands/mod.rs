@@ -27,6 +27,12 @@ use crate::bearing::FaultFrequencies;
 use crate::messages::FaultKind;
 use serde::Serialize;
 
+mod explain;
+mod floor;
+
+use explain::floor_comb;
+use floor::{median_of, subtract_running_median, FloorScratch};
+
 /// Most harmonics a score may use.
 pub const MAX_HARMONICS: usize = 10;
 
@@ -195,9 +201,10 @@ pub struct FaultScorer {
     /// When scoring explained: the prepared excess with the bins the winner's comb explains at
     /// the floor (0).
     unexplained: Vec<f32>,
-    /// Scratch for the medians.
+    /// Scratch for the spread's medians.
     keys: Vec<i32>,
-    knots: Vec<f32>,
+    /// Scratch for the running-median floor.
+    floor: FloorScratch,
 }
 
 /// Relative half-width of a line's search window beside the slip (bearing-geometry and
@@ -225,7 +232,7 @@ impl FaultScorer {
                 .collect(),
             unexplained: Vec::with_capacity(spectrum_bins),
             keys: Vec::with_capacity(spectrum_bins),
-            knots: Vec::with_capacity(spectrum_bins),
+            floor: FloorScratch::with_capacity(spectrum_bins),
         }
     }
 
@@ -284,7 +291,7 @@ impl FaultScorer {
             });
         }
         let FaultScorer {
-            slots, keys, knots, ..
+            slots, keys, floor, ..
         } = self;
         let prepared = &mut slots[slot];
         prepared.excess.clear();
@@ -297,7 +304,7 @@ impl FaultScorer {
         let tiny = f32::MIN_POSITIVE;
         excess.extend(amplitude.iter().map(|&a| a.max(tiny).ln()));
         let half = ((0.3 * lowest / bin_hz).round() as usize).max(8);
-        subtract_running_median(excess, half, keys, knots);
+        subtract_running_median(excess, half, floor);
         // The first bins hold the envelope's DC leakage.
         for e in excess.iter_mut().take(3) {
             *e = 0.0;
@@ -524,144 +531,9 @@ fn line_excess(excess: &[f32], centre: f64, half: f64) -> Option<(usize, f32)> {
     Some(best)
 }
 
-/// `excess -= running median of excess over ±half bins`, the median evaluated every `half/4`
-/// bins and interpolated in between (the floor is smooth at that scale; this keeps the cost
-/// per spectrum near `bins × 8` instead of `bins × half`).
-fn subtract_running_median(
-    excess: &mut [f32],
-    half: usize,
-    keys: &mut Vec<i32>,
-    knots: &mut Vec<f32>,
-) {
-    let n = excess.len();
-    let stride = (half / 4).max(1);
-    knots.clear();
-    let mut centre: usize = 0;
-    loop {
-        let lo = centre.saturating_sub(half);
-        let hi = (centre + half).min(n - 1);
-        knots.push(median_of(excess[lo..=hi].iter().copied(), keys));
-        if centre >= n - 1 {
-            break;
-        }
-        centre = (centre + stride).min(n - 1);
-    }
-    for (i, e) in excess.iter_mut().enumerate() {
-        let k = i / stride;
-        let floor = match (knots.get(k), knots.get(k + 1)) {
-            (Some(&a), Some(&b)) => {
-                let x0 = k * stride;
-                let x1 = ((k + 1) * stride).min(n - 1);
-                let t = if x1 > x0 {
-                    (i - x0) as f32 / (x1 - x0) as f32
-                } else {
-                    0.0
-                };
-                a + (b - a) * t
-            }
-            (Some(&a), None) => a,
-            _ => 0.0,
-        };
-        *e -= floor;
-    }
-}
-
-/// Sets to the floor (0) the bins of `excess` (spaced `bin_hz`) that `winner`'s comb explains
-/// (see [`FaultScorer::score_explained`]); a cage comb has `cage_harmonics` harmonics.
-fn floor_comb(
-    excess: &mut [f32],
-    bin_hz: f64,
-    cage_harmonics: usize,
-    winner: &FaultScore,
-    freqs: &FaultFrequencies,
-) {
-    let n = excess.len();
-    let f = winner.frequency_hz;
-    if !is_positive(f) {
-        return;
-    }
-    let shaft = freqs.shaft * (1.0 + winner.slip);
-    let cage = freqs.ftf * (1.0 + winner.slip);
-    let mut offsets = [0.0; 9];
-    let mut count = 0;
-    for o in [0.0, -2.0, -1.0, 1.0, 2.0] {
-        offsets[count] = o * shaft;
-        count += 1;
-    }
-    if winner.fault == FaultKind::Ball {
-        for o in [-2.0, -1.0, 1.0, 2.0] {
-            offsets[count] = o * cage;
-            count += 1;
-        }
-    }
-    // A cage comb is only its first harmonics (its higher ones are other faults' lines:
-    // BPFO is a multiple of FTF).
-    let last_order = if winner.fault == FaultKind::Cage {
-        cage_harmonics as f64
-    } else {
-        f64::INFINITY
-    };
-    let mut order = 1.0;
-    while (order * f - 2.0 * shaft) / bin_hz < n as f64 && order <= last_order {
-        for offset in &offsets[..count] {
-            floor_line(excess, order * f + offset, order * f, bin_hz);
-        }
-        order += 1.0;
-    }
-    // An outer-race fault is a ball passing a defect; balls differ, so its impacts repeat
-    // with the cage as well. A damaged ball is carried by the cage through the load zone
-    // once per cage turn, so its impacts swell and fade at FTF. Either way the cage comb
-    // is part of what the winner explains.
-    if matches!(winner.fault, FaultKind::OuterRace | FaultKind::Ball) {
-        for order in 1..=cage_harmonics {
-            let line = order as f64 * cage;
-            floor_line(excess, line, line, bin_hz);
-        }
-    }
-}
-
-/// Sets to the floor the bins of a line at `at_hz` whose harmonic sits at `harmonic_hz` (its
-/// width grows with the harmonic, as the scorer's search window does), plus one bin of leakage
-/// each side.
-fn floor_line(excess: &mut [f32], at_hz: f64, harmonic_hz: f64, bin_hz: f64) {
-    let Some(last) = excess.len().checked_sub(1) else {
-        return;
-    };
-    let centre = at_hz / bin_hz;
-    let half = (LINE_HALF_WIDTH * harmonic_hz / bin_hz).max(1.5) + 1.0;
-    let lo = (centre - half).max(0.0) as usize;
-    let hi = ((centre + half).max(0.0) as usize).min(last);
-    for e in excess.iter_mut().take(hi + 1).skip(lo) {
-        *e = 0.0;
-    }
-}
-
 /// `x > 0` and a number (NaN is not).
 fn is_positive(x: f64) -> bool {
     x.is_finite() && x > 0.0
-}
-
-/// The median of `values` (the upper one of an even count; 0 for none), selected on integer
-/// keys that order as [`f32::total_cmp`] orders the values: the same median, with one integer
-/// compare where `total_cmp` converts both operands at every comparison. `keys` is scratch.
-fn median_of(values: impl Iterator<Item = f32>, keys: &mut Vec<i32>) -> f32 {
-    keys.clear();
-    keys.extend(values.map(total_order_key));
-    if keys.is_empty() {
-        return 0.0;
-    }
-    let middle = keys.len() / 2;
-    // The key transform is its own inverse.
-    f32::from_bits(
-        total_order_key(f32::from_bits(*keys.select_nth_unstable(middle).1 as u32)) as u32,
-    )
-}
-
-/// `x`'s bits as an integer that orders as [`f32::total_cmp`] orders floats (negative values
-/// have their magnitude bits flipped).
-fn total_order_key(x: f32) -> i32 {
-    let bits = x.to_bits() as i32;
-    bits ^ ((((bits >> 31) as u32) >> 1) as i32)
 }
 
 #[cfg(test)]
@@ -671,26 +543,6 @@ mod tests {
     use crate::random::Rng;
 
     const BIN_HZ: f64 = 12_000.0 / 4096.0;
-
-    #[test]
-    fn the_median_on_integer_keys_is_the_total_order_median() {
-        let mut rng = Rng::new(3);
-        let mut keys = Vec::new();
-        for len in [1usize, 2, 3, 8, 81, 1_200] {
-            let mut values: Vec<f32> = (0..len).map(|_| (rng.normal() * 30.0) as f32).collect();
-            values[0] = -0.0;
-            if len > 3 {
-                values[1] = f32::INFINITY;
-                values[2] = f32::NEG_INFINITY;
-                values[3] = 0.0;
-            }
-            let mut sorted = values.clone();
-            sorted.sort_by(f32::total_cmp);
-            let got = median_of(values.iter().copied(), &mut keys);
-            assert_eq!(got.to_bits(), sorted[len / 2].to_bits(), "len {len}");
-        }
-        assert_eq!(median_of(std::iter::empty(), &mut keys), 0.0);
-    }
 
     fn cwru() -> FaultFrequencies {
         BearingGeometry::from_catalog("skf-6205-2rs")
