@@ -45,169 +45,35 @@
 //!   of samples after they started, so that the analysis never waits 30–100 ms for one.
 //!
 //! Allocation: the per-hop path allocates nothing; a band re-selection (once a minute) does.
+//!
+//! The files: this one holds the channel's state and its per-hop path; `selection` the band
+//! selections and the flags following their verdicts, `sensor` the clipping and flat-line
+//! watch, `events` what comes out, `settings` what goes in.
+
+mod events;
+mod selection;
+mod sensor;
+mod settings;
+
+pub use events::{MonitorEvent, SensorCondition, WindowReport};
+pub use settings::{MonitorSettings, TrendSettings};
 
 use super::agreement::Witness;
 use super::band::envelope_range_hz;
-use super::band_selection::Evidence;
-use super::band_selection::{
-    scaled, usable_shaft_hz, BandJob, BandResult, BandSelector, InlineSelector,
-};
-use super::degradation::{RmsTrend, TrendPoint};
+use super::band_selection::{scaled, usable_shaft_hz, BandSelector, InlineSelector};
+use super::degradation::RmsTrend;
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
-use super::flags::{FaultFlag, FlagChange, FlagSettings};
-use super::health::{Baseline, HealthTracker, StageChange, CONFIRM_WINDOWS};
+use super::flags::FaultFlag;
+use super::health::{Baseline, HealthTracker, CONFIRM_WINDOWS};
 use super::indicators::Indicators;
-use super::iso::{SeveritySettings, VelocityReading, VelocityTracker, ZoneLimits};
+use super::iso::VelocityTracker;
 use super::speed::SpeedMode;
-use super::{AnalysisSettings, Band};
+use super::Band;
 use crate::bearing::FaultFrequencies;
-use crate::messages::{FaultKind, FlagLevel, HealthKind, HealthStage};
-
-/// Everything a monitor needs, with durations already in samples.
-#[derive(Debug, Clone)]
-pub struct MonitorSettings {
-    pub fs_hz: f64,
-    pub analysis: AnalysisSettings,
-    pub band_period_samples: u64,
-    /// Extra delay of the second band selection (the first is as soon as the history is
-    /// full), so that the channels of one daemon take turns instead of all selecting at the
-    /// same sample time: each selection holds the analysis thread for tens of ms, and a burst
-    /// over all channels delays every block (and alert) behind it. 0 for a lone channel.
-    pub band_phase_samples: u64,
-    /// This channel's share of a hop, `(k, n)` for the k-th of n channels: its windows end
-    /// k/n of a hop later than the first channel's, so that the daemon's channels do not all
-    /// close a window (envelope spectra, scores, flags, velocity) on the same block, each
-    /// waiting behind the others; a window's alert then waits for one channel's work, not
-    /// all. `(0, 1)` for a lone channel.
-    pub window_stagger: (usize, usize),
-    pub band_history_samples: usize,
-    pub flags: FlagSettings,
-    pub baseline_windows: u64,
-    pub sigma: f64,
-    /// A count whose magnitude reaches this is clipped (i16 full scale: 32767).
-    pub clip_count: i32,
-    /// Samples without any change that make a flat line.
-    pub flat_line_samples: u64,
-    /// Where the shaft speed comes from.
-    pub speed: SpeedMode,
-    /// The machine the velocity zones are judged for; `None`: no velocity analysis.
-    pub severity: Option<SeveritySettings>,
-    /// The RMS trend published with the health stage.
-    pub trend: TrendSettings,
-}
-
-/// How the RMS trend is made ([`RmsTrend`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TrendSettings {
-    /// Sample time per point (the median of its windows' RMS).
-    pub point_s: f64,
-    /// Points fitted (the newest).
-    pub points: usize,
-    /// Two-sided coverage of the band around the fit.
-    pub confidence: f64,
-}
-
-impl Default for TrendSettings {
-    /// A point a minute, the last 30 fitted, a 90 % band (`bearingd trend`'s coverage).
-    fn default() -> Self {
-        TrendSettings {
-            point_s: 60.0,
-            points: 30,
-            confidence: 0.9,
-        }
-    }
-}
-
-/// A sensor-health finding.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SensorCondition {
-    Clipping,
-    FlatLine,
-}
-
-impl From<SensorCondition> for HealthKind {
-    fn from(condition: SensorCondition) -> HealthKind {
-        match condition {
-            SensorCondition::Clipping => HealthKind::Saturation,
-            SensorCondition::FlatLine => HealthKind::FlatLine,
-        }
-    }
-}
-
-/// One hop's results.
-pub struct WindowReport<'a> {
-    pub end_sample: u64,
-    pub indicators: Indicators,
-    /// In [`FaultKind::ALL`] order, each from its own band.
-    pub scores: &'a [FaultScore; 4],
-    pub bands: &'a [Band; 4],
-    /// Averaged amplitude spectrum of the band of the highest score.
-    pub spectrum: &'a [f32],
-    pub spectrum_band: Band,
-    pub bin_hz: f64,
-    pub windows_averaged: usize,
-}
-
-/// What the monitor tells its driver.
-pub enum MonitorEvent<'a> {
-    Window(WindowReport<'a>),
-    Flag {
-        fault: FaultKind,
-        change: FlagChange,
-        score: f64,
-        frequency_hz: f64,
-        /// The largest score of the other faults in the same window (at least 1e-9).
-        runner_up: f64,
-    },
-    Stage(StageChange),
-    /// A new point of the RMS trend, with the stage it was made in.
-    Trend {
-        point: TrendPoint,
-        stage: HealthStage,
-    },
-    Sensor {
-        condition: SensorCondition,
-        active: bool,
-        at_sample: u64,
-    },
-    /// A band selection's result: its bands and the verdict on its history (from
-    /// `evidence_from` to `at_sample`), which the flags follow.
-    Bands {
-        at_sample: u64,
-        bands: [Band; 4],
-        selected: Band,
-        evidence: Option<&'a Evidence>,
-        evidence_from: u64,
-    },
-    /// A velocity reading ([`super::iso`]) and the zone flag's level after it.
-    Velocity {
-        reading: VelocityReading,
-        band_hz: (f64, f64),
-        flag: FlagLevel,
-    },
-    /// The velocity zone flag changed level.
-    VelocityFlag {
-        change: FlagChange,
-        reading: VelocityReading,
-        limits: ZoneLimits,
-    },
-    /// Samples were missing: the windows restart after the gap.
-    Gap {
-        at_sample: u64,
-        missing: u64,
-    },
-    /// The shaft speed the channel uses changed (or was set again), from `at_sample` on;
-    /// `shaft_hz` is `None` when it is unknown or unusable from there (see [`SpeedMode`]).
-    Speed {
-        at_sample: u64,
-        shaft_hz: Option<f64>,
-        /// Given to `set_speed_at` (`None` if it was "not available"); differs from
-        /// `shaft_hz` when the given speed is not usable.
-        given_hz: Option<f64>,
-        estimated: bool,
-    },
-}
+use crate::messages::{FaultKind, FlagLevel, HealthStage};
+use events::velocity_events;
+use sensor::SensorWatch;
 
 /// The streaming analysis of one channel.
 pub struct ChannelMonitor {
@@ -239,11 +105,7 @@ pub struct ChannelMonitor {
     band_phase_left: u64,
     next_sample: u64,
     scratch: Vec<f32>,
-    clipping: bool,
-    last_clip: u64,
-    flat: bool,
-    flat_since: u64,
-    last_count: Option<i32>,
+    sensor: SensorWatch,
     /// Runs the band selections ([`InlineSelector`] unless given one).
     band_selector: Box<dyn BandSelector>,
     /// The fault the latest verdict the flags followed named by agreement with the witness.
@@ -283,7 +145,7 @@ impl ChannelMonitor {
         baseline: Option<Baseline>,
     ) -> Self {
         let window = window_samples(settings.analysis.window_s, settings.fs_hz);
-        let hop = super::envelope::hop_samples(window, settings.analysis.overlap);
+        let hop = crate::analysis::envelope::hop_samples(window, settings.analysis.overlap);
         let bin_hz = settings.fs_hz / window as f64;
         let orders = scaled(&freqs, 1.0 / freqs.shaft);
         let fastest = scaled(&orders, settings.speed.max_shaft_hz(freqs.shaft));
@@ -359,11 +221,7 @@ impl ChannelMonitor {
             band_phase_left: settings.band_phase_samples,
             next_sample: 0,
             scratch: vec![0.0; CHUNK],
-            clipping: false,
-            last_clip: 0,
-            flat: false,
-            flat_since: 0,
-            last_count: None,
+            sensor: SensorWatch::new(settings.clip_count, settings.flat_line_samples),
             band_selector: Box::new(InlineSelector::default()),
             witness: None,
             agreed: None,
@@ -398,7 +256,7 @@ impl ChannelMonitor {
     }
 
     /// The monitor with a second witness its verdicts hear (the learned model), by
-    /// `analysis.agreement` ([`super::agreement::decide`]).
+    /// `analysis.agreement` ([`crate::analysis::agreement::decide`]).
     pub fn with_witness(mut self, witness: std::sync::Arc<dyn Witness>) -> Self {
         self.witness = Some(witness);
         self
@@ -473,7 +331,7 @@ impl ChannelMonitor {
     }
 
     /// The fault the latest verdict the flags followed named by agreement with the second
-    /// witness ([`super::diagnosis::Named::Agreed`]), if it did.
+    /// witness ([`crate::analysis::diagnosis::Named::Agreed`]), if it did.
     pub fn agreed_fault(&self) -> Option<FaultKind> {
         self.agreed
     }
@@ -484,7 +342,7 @@ impl ChannelMonitor {
     }
 
     /// The verdict's rule the flags are fed by.
-    pub fn decision_rule(&self) -> super::diagnosis::DecisionRule {
+    pub fn decision_rule(&self) -> crate::analysis::diagnosis::DecisionRule {
         self.settings.analysis.decision_rule()
     }
 
@@ -541,7 +399,7 @@ impl ChannelMonitor {
             }
             self.history_filled = 0;
             self.next_sample = first_sample;
-            self.last_count = None;
+            self.sensor.restart();
         }
         if scale_g_per_count != self.history_scale {
             // A new scale (a reconfigured sensor): the history in the old one is dropped.
@@ -549,7 +407,7 @@ impl ChannelMonitor {
             self.history_filled = 0;
         }
         for chunk in counts.chunks(CHUNK) {
-            self.check_sensor(chunk, on_event);
+            self.sensor.check(self.next_sample, chunk, on_event);
             let mut scratch = std::mem::take(&mut self.scratch);
             for (s, &c) in scratch.iter_mut().zip(chunk) {
                 *s = (f64::from(c) * scale_g_per_count) as f32;
@@ -688,199 +546,7 @@ impl ChannelMonitor {
         });
     }
 
-    /// The history's filled part as counts, oldest first.
-    fn history_counts(&self) -> Vec<i16> {
-        let n = self.history.len();
-        let filled = self.history_filled.min(n);
-        (0..filled)
-            .map(|i| self.history[(self.history_at + n - filled + i) % n])
-            .collect()
-    }
-
     fn history_sample(&self, index: usize) -> f32 {
         (f64::from(self.history[index]) * self.history_scale) as f32
     }
-
-    /// Starts a band selection over the history (unless one is under way, or nothing could
-    /// be scored: no speed and no estimate); with no delay its result is used at once.
-    fn start_band_selection(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
-        let estimating = matches!(self.settings.speed, SpeedMode::Estimate(_));
-        if self.band_result_at.is_some() || (!self.speed_known && !estimating) {
-            return;
-        }
-        let counts = self.history_counts();
-        self.band_job_from = self.next_sample - counts.len() as u64;
-        self.evidence_until = self.next_sample;
-        self.band_selector.start(std::sync::Arc::new(BandJob {
-            counts,
-            scale: self.history_scale,
-            fs_hz: self.settings.fs_hz,
-            freqs: self.freqs,
-            orders: self.orders,
-            speed_known: self.speed_known,
-            max_shaft_hz: self.settings.speed.max_shaft_hz(self.freqs.shaft),
-            speed: self.settings.speed,
-            analysis: self.settings.analysis.clone(),
-            witness: self.witness.clone(),
-        }));
-        self.band_result_at = Some(self.next_sample + self.band_delay_samples);
-        if self.band_delay_samples == 0 {
-            self.use_band_result(on_event);
-        }
-    }
-
-    /// Takes the result of the selection under way (waiting for it if it is not done) and
-    /// follows its speed estimate and its bands.
-    fn use_band_result(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
-        self.band_result_at = None;
-        let Some(BandResult {
-            estimated_shaft_hz,
-            bands,
-            evidence,
-        }) = self.band_selector.finish()
-        else {
-            return;
-        };
-        if let Some(hz) = estimated_shaft_hz {
-            self.apply_speed(Some(hz), true, on_event);
-        }
-        let Some((bands, selected)) = bands.filter(|_| self.speed_known) else {
-            return;
-        };
-        if !self.bands_known || bands != self.bands {
-            self.rolling.set_bands(&bands);
-            self.bands = bands;
-        }
-        self.bands_known = true;
-        on_event(MonitorEvent::Bands {
-            at_sample: self.next_sample,
-            bands,
-            selected,
-            evidence: evidence.as_ref(),
-            evidence_from: self.band_job_from,
-        });
-        // The flags move on a whole horizon of evidence, or on all there is at the signal's end:
-        // a shorter stretch (the first seconds, the seconds after a gap) chooses bands only.
-        if let Some(evidence) = evidence.filter(|e| e.samples >= self.history.len() || self.ending)
-        {
-            self.follow_evidence(&evidence, on_event);
-        }
-    }
-
-    /// The flags follow the verdict on the selection's history: the fault it names asks for
-    /// its score's level (watch at least), every other fault for ok; a level asked for counts
-    /// as asked since the history's first sample ([`FaultFlag::update_over`]), so a verdict on
-    /// more evidence than the on-delay raises its flag at once.
-    fn follow_evidence(&mut self, evidence: &Evidence, on_event: &mut impl FnMut(MonitorEvent)) {
-        let at = self.next_sample;
-        let from = self.band_job_from;
-        self.agreed = evidence
-            .verdict
-            .fault()
-            .filter(|_| evidence.named == Some(super::diagnosis::Named::Agreed));
-        for (i, kind) in FaultKind::ALL.iter().enumerate() {
-            let score = &evidence.scores[i];
-            let asked = if evidence.named.is_some() && evidence.verdict.faults().contains(kind) {
-                score.score.max(self.flags[i].settings().watch_score)
-            } else {
-                0.0
-            };
-            if let Some(change) = self.flags[i].update_over(asked, from, at) {
-                on_event(MonitorEvent::Flag {
-                    fault: *kind,
-                    change,
-                    score: score.score,
-                    frequency_hz: score.frequency_hz,
-                    runner_up: evidence.runner_up(*kind),
-                });
-            }
-        }
-    }
-
-    /// The end of the signal (a replay's, an evaluation's, or a clean stop): the selection
-    /// under way is used now, and the evidence not yet analysed (the samples since the last
-    /// selection) gets a last selection over the history, used at once, so that the flags end
-    /// on the verdict of everything the channel saw.
-    pub fn finish(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
-        self.ending = true;
-        if self.band_result_at.is_some() {
-            self.use_band_result(on_event);
-        }
-        if self.next_sample > self.evidence_until && self.history_filled > 0 {
-            let delay = std::mem::replace(&mut self.band_delay_samples, 0);
-            self.start_band_selection(on_event);
-            self.band_delay_samples = delay;
-        }
-    }
-
-    /// Clipping starts at the first count at full scale and ends after a quiet stretch as long
-    /// as the flat-line length; a flat line starts once the count has not changed for that
-    /// long. Both are judged sample by sample, so block boundaries do not matter.
-    fn check_sensor(&mut self, counts: &[i16], on_event: &mut impl FnMut(MonitorEvent)) {
-        let at = self.next_sample;
-        for (i, &c) in counts.iter().enumerate() {
-            let sample = at + i as u64;
-            let c = i32::from(c);
-            if c.abs() >= self.settings.clip_count {
-                self.last_clip = sample;
-                if !self.clipping {
-                    self.clipping = true;
-                    on_event(MonitorEvent::Sensor {
-                        condition: SensorCondition::Clipping,
-                        active: true,
-                        at_sample: sample,
-                    });
-                }
-            } else if self.clipping && sample - self.last_clip >= self.settings.flat_line_samples {
-                self.clipping = false;
-                on_event(MonitorEvent::Sensor {
-                    condition: SensorCondition::Clipping,
-                    active: false,
-                    at_sample: sample,
-                });
-            }
-            if self.last_count != Some(c) {
-                self.flat_since = sample;
-                self.last_count = Some(c);
-                if self.flat {
-                    self.flat = false;
-                    on_event(MonitorEvent::Sensor {
-                        condition: SensorCondition::FlatLine,
-                        active: false,
-                        at_sample: sample,
-                    });
-                }
-            } else if !self.flat && sample + 1 - self.flat_since >= self.settings.flat_line_samples
-            {
-                self.flat = true;
-                on_event(MonitorEvent::Sensor {
-                    condition: SensorCondition::FlatLine,
-                    active: true,
-                    at_sample: sample,
-                });
-            }
-        }
-    }
-}
-
-/// The events of one velocity reading: its zone flag's change, if any, then the reading.
-fn velocity_events(
-    reading: VelocityReading,
-    band_hz: (f64, f64),
-    limits: ZoneLimits,
-    flag: &mut FaultFlag,
-    on_event: &mut impl FnMut(MonitorEvent),
-) {
-    if let Some(change) = flag.update(reading.rms_mm_s, reading.end_sample) {
-        on_event(MonitorEvent::VelocityFlag {
-            change,
-            reading,
-            limits,
-        });
-    }
-    on_event(MonitorEvent::Velocity {
-        reading,
-        band_hz,
-        flag: flag.level(),
-    });
 }

@@ -1,0 +1,271 @@
+//! Turns a [`Figure`] into a [`Scene`]: a flat list of drawing primitives in pixel
+//! coordinates. Every placement decision (margins, ticks, legends, label staggering, colour
+//! mapping, decimation) is made here once; the SVG and PNG renderers only translate primitives.
+//!
+//! The files: this one holds the primitives, the shared sizes and the figure's header;
+//! `spectrum` and `heatmap` lay out one panel each, on the frame, grid, ticks and axis
+//! titles of `axes`.
+
+mod axes;
+mod heatmap;
+mod spectrum;
+
+use super::figure::{Color, Figure, Panel};
+use super::PlotError;
+use heatmap::heatmap_panel;
+use spectrum::spectrum_panel;
+
+/// Width of one glyph cell at text scale 1, in pixels (the 8×8 bitmap font; the SVG uses a
+/// monospace font sized to the same advance).
+pub(crate) const GLYPH_SIZE: f64 = 8.0;
+
+/// Figure width in pixels.
+const FIGURE_WIDTH: f64 = 1200.0;
+/// Height of one panel in pixels.
+const PANEL_HEIGHT: f64 = 380.0;
+/// More panels than this would make an unreasonably tall image.
+pub(crate) const MAX_PANELS: usize = 16;
+/// Notes beyond this many lines are summarised as "… n more".
+const MAX_NOTE_LINES: usize = 12;
+
+const OUTER_PAD: f64 = 16.0;
+const PLOT_LEFT: f64 = 96.0;
+const PLOT_RIGHT_PAD: f64 = 32.0;
+const LINE_HEIGHT: f64 = 14.0;
+const TITLE_SCALE: u32 = 2;
+const TEXT_SCALE: u32 = 1;
+
+const TEXT_COLOR: Color = Color::rgb(30, 30, 30);
+const MUTED_TEXT: Color = Color::rgb(80, 80, 80);
+const FRAME_COLOR: Color = Color::rgb(60, 60, 60);
+const GRID_COLOR: Color = Color::rgb(228, 228, 228);
+
+/// A line style.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Stroke {
+    pub color: Color,
+    pub width: f64,
+    /// Dash and gap lengths; `None` for a solid line.
+    pub dash: Option<(f64, f64)>,
+}
+
+impl Stroke {
+    fn solid(color: Color, width: f64) -> Self {
+        Stroke {
+            color,
+            width,
+            dash: None,
+        }
+    }
+}
+
+/// Horizontal alignment of text relative to its anchor point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Anchor {
+    Start,
+    Middle,
+    End,
+}
+
+impl Anchor {
+    /// Share of the text width lying before the anchor point.
+    pub fn offset_fraction(self) -> f64 {
+        match self {
+            Anchor::Start => 0.0,
+            Anchor::Middle => 0.5,
+            Anchor::End => 1.0,
+        }
+    }
+}
+
+/// A line of text set in the 8×8 font at an integer scale.
+///
+/// Horizontal text: `x` is the anchor point along the line, `y` the top of the glyph box.
+/// Vertical text (reading bottom to top): `x` is the left of the rotated glyph box and `y`
+/// the anchor point along the line.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Text {
+    pub x: f64,
+    pub y: f64,
+    pub content: String,
+    pub scale: u32,
+    pub anchor: Anchor,
+    pub color: Color,
+    pub vertical: bool,
+}
+
+/// One drawing primitive, in pixel coordinates with y pointing down.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Item {
+    Rect {
+        x: f64,
+        y: f64,
+        width: f64,
+        height: f64,
+        fill: Option<Color>,
+        stroke: Option<Stroke>,
+        /// Edges lie on whole pixels and must not be anti-aliased (heatmap cells).
+        crisp: bool,
+    },
+    Polyline {
+        points: Vec<(f64, f64)>,
+        stroke: Stroke,
+    },
+    Dot {
+        x: f64,
+        y: f64,
+        radius: f64,
+        color: Color,
+    },
+    Text(Text),
+}
+
+/// A figure laid out: canvas size, background and primitives in painting order.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Scene {
+    pub width: u32,
+    pub height: u32,
+    pub background: Color,
+    pub items: Vec<Item>,
+}
+
+/// Width in pixels of `text` at `scale`.
+pub(crate) fn text_width(text: &str, scale: u32) -> f64 {
+    text.chars().count() as f64 * GLYPH_SIZE * f64::from(scale)
+}
+
+/// `text` shortened with "..." so that it fits `max_width` pixels at `scale`.
+fn fit_text(text: &str, scale: u32, max_width: f64) -> String {
+    let capacity = (max_width / (GLYPH_SIZE * f64::from(scale)))
+        .floor()
+        .max(0.0) as usize;
+    if text.chars().count() <= capacity {
+        return text.to_string();
+    }
+    if capacity <= 3 {
+        return text.chars().take(capacity).collect();
+    }
+    let mut short: String = text.chars().take(capacity - 3).collect();
+    short.push_str("...");
+    short
+}
+
+/// Half-pixel aligned coordinate so that a 1 px line covers exactly one pixel row or column.
+fn crisp(v: f64) -> f64 {
+    v.floor() + 0.5
+}
+
+/// Lays out a whole figure.
+pub(crate) fn build(figure: &Figure) -> Result<Scene, PlotError> {
+    if figure.panels.is_empty() {
+        return Err(PlotError::NoPanels);
+    }
+    if figure.panels.len() > MAX_PANELS {
+        return Err(PlotError::TooManyPanels {
+            count: figure.panels.len(),
+            max: MAX_PANELS,
+        });
+    }
+    let mut items = Vec::new();
+    let header_bottom = header(figure, &mut items);
+    let mut top = header_bottom;
+    for panel in &figure.panels {
+        match panel {
+            Panel::Spectrum(spectrum) => spectrum_panel(spectrum, top, &mut items),
+            Panel::Heatmap(heatmap) => heatmap_panel(heatmap, top, &mut items),
+        }
+        top += PANEL_HEIGHT;
+    }
+    Ok(Scene {
+        width: FIGURE_WIDTH as u32,
+        height: (top + OUTER_PAD).ceil() as u32,
+        background: Color::WHITE,
+        items,
+    })
+}
+
+fn text(x: f64, y: f64, content: String, scale: u32, anchor: Anchor, color: Color) -> Item {
+    Item::Text(Text {
+        x,
+        y,
+        content,
+        scale,
+        anchor,
+        color,
+        vertical: false,
+    })
+}
+
+/// Title and notes; returns the y where panels start.
+fn header(figure: &Figure, items: &mut Vec<Item>) -> f64 {
+    let max_width = FIGURE_WIDTH - 2.0 * OUTER_PAD;
+    let mut y = OUTER_PAD;
+    items.push(text(
+        OUTER_PAD,
+        y,
+        fit_text(&figure.title, TITLE_SCALE, max_width),
+        TITLE_SCALE,
+        Anchor::Start,
+        TEXT_COLOR,
+    ));
+    y += GLYPH_SIZE * f64::from(TITLE_SCALE) + 10.0;
+    let shown = if figure.notes.len() > MAX_NOTE_LINES {
+        MAX_NOTE_LINES - 1
+    } else {
+        figure.notes.len()
+    };
+    for note in &figure.notes[..shown] {
+        items.push(text(
+            OUTER_PAD,
+            y,
+            fit_text(note, TEXT_SCALE, max_width),
+            TEXT_SCALE,
+            Anchor::Start,
+            MUTED_TEXT,
+        ));
+        y += LINE_HEIGHT;
+    }
+    if shown < figure.notes.len() {
+        let more = format!("... {} more", figure.notes.len() - shown);
+        items.push(text(
+            OUTER_PAD,
+            y,
+            more,
+            TEXT_SCALE,
+            Anchor::Start,
+            MUTED_TEXT,
+        ));
+        y += LINE_HEIGHT;
+    }
+    y + 4.0
+}
+
+/// The plot rectangle of a panel, in pixels.
+#[derive(Debug, Clone, Copy)]
+struct PlotArea {
+    left: f64,
+    top: f64,
+    right: f64,
+    bottom: f64,
+}
+
+impl PlotArea {
+    fn width(&self) -> f64 {
+        self.right - self.left
+    }
+    fn height(&self) -> f64 {
+        self.bottom - self.top
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn text_is_shortened_to_fit() {
+        assert_eq!(fit_text("abcdefgh", 1, 48.0), "abc...");
+        assert_eq!(fit_text("abc", 1, 48.0), "abc");
+        assert_eq!(fit_text("abc", 1, 0.0), "");
+    }
+}

@@ -1,0 +1,130 @@
+//! Where samples come from and where results go: transport tables, outputs, the iceoryx2
+//! root, the CPU wake-up latency.
+
+use super::{assert_has_fix, config_of, keys, problems, SENSOR};
+use bearingd::config::{self, CanConfig, Transport};
+
+#[test]
+fn transport_tables_must_match_the_transport() {
+    let can_on_sim = format!("{SENSOR}[sensors.can]\nnode_id = 1\n");
+    let found = problems(&can_on_sim);
+    assert_eq!(keys(&found), ["sensors[0].can"]);
+    assert!(
+        found[0].message.contains("transport is \"sim\""),
+        "{}",
+        found[0]
+    );
+
+    let can_without_table = SENSOR.replace("\"sim\"", "\"can\"");
+    let found = problems(&can_without_table);
+    assert_eq!(keys(&found), ["sensors[0].can"]);
+
+    let can = format!(
+        "{}[sensors.can]\ninterface = \"vcan0\"\nnode_id = 3\nfd = true\n",
+        SENSOR.replace("\"sim\"", "\"can\"")
+    );
+    let config = config::parse(&can, "can.toml").unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(
+        config.sensors[0].transport,
+        Transport::Can(CanConfig {
+            interface: "vcan0".into(),
+            node_id: 3,
+            fd: true
+        })
+    );
+
+    let two_nodes = format!("{can}{}", can.replace("motor-de", "fan-de"));
+    let found = problems(&two_nodes);
+    assert_eq!(keys(&found), ["sensors[1].can.node_id"], "{found:#?}");
+
+    let shm = SENSOR.replace("\"sim\"", "\"shm\"");
+    let config = config::parse(&shm, "shm.toml").unwrap_or_else(|e| panic!("{e}"));
+    let Transport::Shm(shm_config) = &config.sensors[0].transport else {
+        panic!("{:?}", config.sensors[0].transport)
+    };
+    assert_eq!(shm_config.service, "bearingd/accel/motor-de");
+
+    let outside = format!("{shm}[sensors.shm]\nservice = \"accel/motor-de\"\n");
+    let found = problems(&outside);
+    assert_eq!(keys(&found), ["sensors[0].shm.service"]);
+    found.iter().for_each(assert_has_fix);
+
+    let on_alerts = format!("{shm}[sensors.shm]\nservice = \"bearingd/alerts\"\n");
+    let found = problems(&on_alerts);
+    assert_eq!(keys(&found), ["sensors[0].shm.service"]);
+    assert!(found[0].message.contains("alerts_service"), "{}", found[0]);
+    assert!(
+        found[0].message.contains("\"bearingd/accel/motor-de\""),
+        "{}",
+        found[0]
+    );
+}
+
+#[test]
+fn output_checks_say_why() {
+    let text = format!(
+        "{SENSOR}[outputs]\nmcap_max_file_mb = 512\nmcap_disk_budget_mb = 600\n\
+         iceoryx2_root = \"run/iceoryx2\"\nalerts_service = \"alerts\"\n"
+    );
+    let found = problems(&text);
+    assert_eq!(
+        keys(&found),
+        [
+            "outputs.mcap_disk_budget_mb",
+            "outputs.alerts_service",
+            "outputs.iceoryx2_root",
+        ],
+        "{found:#?}"
+    );
+    assert!(found[0].message.contains("open file"), "{}", found[0]);
+    assert!(found[2].message.contains("absolute"), "{}", found[2]);
+    found.iter().for_each(assert_has_fix);
+
+    let found = problems(&format!(
+        "{SENSOR}[outputs]\niceoryx2_root = \"/var/tmp/x\"\n"
+    ));
+    assert!(found[0].message.contains("PrivateTmp"), "{}", found[0]);
+}
+
+#[test]
+fn the_cpu_wakeup_latency_is_off_unless_given_and_then_within_0_to_1_s() {
+    assert_eq!(config_of(SENSOR).outputs.cpu_wakeup_latency_us, None);
+    let given = config_of(&format!("{SENSOR}[outputs]\ncpu_wakeup_latency_us = 0\n"));
+    assert_eq!(given.outputs.cpu_wakeup_latency_us, Some(0));
+    for bad in ["-1", "1000001", "\"low\""] {
+        let found = problems(&format!(
+            "{SENSOR}[outputs]\ncpu_wakeup_latency_us = {bad}\n"
+        ));
+        assert_eq!(
+            keys(&found),
+            ["outputs.cpu_wakeup_latency_us"],
+            "{bad}: {found:#?}"
+        );
+        found.iter().for_each(assert_has_fix);
+    }
+}
+
+#[test]
+fn transport_tables_are_checked_even_when_the_transport_is_wrong() {
+    let text = SENSOR.replace("\"sim\"", "\"cam\"") + "[sensors.can]\nnode_id = 99\n";
+    let found = problems(&text);
+    assert_eq!(
+        keys(&found),
+        ["sensors[0].transport", "sensors[0].can.node_id"],
+        "{found:#?}"
+    );
+}
+
+#[test]
+fn an_iceoryx2_root_too_long_for_its_sockets_is_refused() {
+    let long = format!("/srv/{}", "r".repeat(60));
+    let text = format!("{SENSOR}[outputs]\niceoryx2_root = \"{long}\"\n");
+    let problems = bearingd::config::parse(&text, "t.toml")
+        .unwrap_err()
+        .problems;
+    let problem = problems
+        .iter()
+        .find(|p| p.key == "outputs.iceoryx2_root")
+        .unwrap_or_else(|| panic!("{problems:?}"));
+    assert!(problem.message.contains("108 bytes"), "{}", problem.message);
+}
