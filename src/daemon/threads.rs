@@ -244,10 +244,12 @@ pub(super) fn sink_thread(
 
 #[cfg(test)]
 mod tests {
+    use super::super::run::SINK_QUEUE;
     use super::*;
+    use crate::config::Config;
     use crate::messages::{AlertMessage, AlertState, AlertSubject, ChannelId, FaultKind};
     use crate::messages::{FlagLevel, HealthKind, HealthMessage};
-    use std::sync::Mutex;
+    use std::sync::{Arc, Mutex};
 
     /// What an immediate sink saw: each item's kind, the wall time it was told last, and
     /// whether the sink queue held anything yet.
