@@ -6,7 +6,8 @@
 //! in mm/s, and the ISO 10816-3 zones judge how bad a vibration is in the same unit, so a
 //! finding's level is the zone of its own lines' velocity, not a score of our own.
 //!
-//! Method (choices, calibrated on the simulator only; docs/DIAGNOSIS.md "Machine faults"):
+//! Method (choices, calibrated on the simulator only; docs/DIAGNOSIS.md §4 "Machine faults at
+//! shaft orders"):
 //! - **Lines.** From the velocity power per bin (the ISO integrator's, (mm/s)² per bin), each
 //!   order `k = 0.5, 1, 1.5, …, 10` of the shaft rate is the strongest bin within ±1 % of
 //!   `k·fr` (at least ±1 bin) with its two neighbours (a Hann window's main lobe holds a tone's
