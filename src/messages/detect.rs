@@ -1,17 +1,23 @@
 //! What a detector says, in one shape every consumer can handle without knowing the detector:
 //! its records ([`Record`]: a reading, or a change of one of its flags, [`FlagRecord`]) and the
-//! one list of detectors ([`detectors!`] at the end of this file) that makes
+//! one list of detectors (the `detectors!` invocation at the end of this file) that makes
 //! [`DetectorMessage`], the pipeline's single message variant for all of them.
 //!
-//! Why here and not in `analysis`: [`PipelineMessage`](super::PipelineMessage) must name every
-//! detector's messages, and `messages` is the bottom room that the analysis, the MCAP log and
-//! every sink build on (`src/lib.rs` "# Layout"); a list in `analysis` would make `messages`
-//! depend on a room above it. So the message half of a detector lives in `messages` (its own
-//! file, e.g. [`super::velocity`]), the computing half in `analysis`.
+//! Why here and not in `analysis` (where issue 31's design put it): [`PipelineMessage`] must
+//! name every detector's messages, and `messages` is the bottom room that the analysis, the
+//! MCAP log and every sink build on (`src/lib.rs` "# Layout"); a list in `analysis` would make
+//! `messages` depend on a room above it. So the message half of a detector lives here (its
+//! records in a file of their own, `messages/velocity.rs`), the computing half in `analysis`.
 //!
 //! What is generic then (no per-detector code): the MCAP log's topics, schemas, encoding and
-//! decoding ([`RecordKind`]), late flag changes, the accessors (`channel`, `end_sample`) and
-//! [`DetectorMessage::as_flag`] for alerts, status and flag comparisons.
+//! decoding ([`RecordKind`]), late flag changes, the accessors (`channel`, `end_sample`),
+//! alerts (score, confidence, the code and name of [`FlagSpec`]), `bearingd alerts`' and
+//! `run`'s flag lines, the status flags and the fleet's metrics ([`MetricSpec`]).
+//!
+//! A new detector: its records in `messages/<name>.rs` (the [`Record`] and [`FlagRecord`]
+//! impls), one line in `detectors!`, its computation in `analysis`; until the monitor runs
+//! detectors through a trait of their own (issue 31 step C3), its events still become messages
+//! in `pipeline::handle_event`.
 //!
 //! Dispatch: one `match` per message (generated) to a `&dyn` [`AnyRecord`]: a vtable call per
 //! low-rate message (a reading every half second per channel), no allocation, and far less

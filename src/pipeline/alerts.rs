@@ -26,17 +26,11 @@ use super::Output;
 /// Passes `output` on; after a flag change, the alerts it decides: the pipeline's outputs as
 /// its sinks see them.
 pub(super) fn pass_on(alerts: &mut AlertTracker, output: Output, out: &mut impl FnMut(Output)) {
-    let is_flag = |m: &PipelineMessage| match m {
-        PipelineMessage::Flag(_) => true,
-        PipelineMessage::Detector(m) => m.as_flag().is_some(),
-        _ => false,
+    let flag = match &output {
+        Output::Message(m @ PipelineMessage::Flag(_)) => m,
+        Output::Message(m @ PipelineMessage::Detector(d)) if d.as_flag().is_some() => m,
+        _ => return out(output),
     };
-    let Output::Message(flag) = &output else {
-        return out(output);
-    };
-    if !is_flag(flag) {
-        return out(output);
-    }
     let mut decided = Vec::with_capacity(1);
     alerts.observe(flag, &mut |alert| decided.push(alert));
     out(output);
