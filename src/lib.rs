@@ -44,7 +44,8 @@
 //! - [`mcap_log`]: the MCAP log's format: topics, schemas, file names, the bounded scanner and
 //!   the reader (the writer is a sink, the replay a source).
 //! - [`messages`]: the vocabulary every room above speaks: typed faults, flags, health stages,
-//!   speed sources and the pipeline's messages; MCAP and iceoryx2 encode them at the edge.
+//!   speed sources and the pipeline's messages, with the one list of detectors whose messages
+//!   the pipeline carries ([`messages::detect`]); MCAP and iceoryx2 encode them at the edge.
 //! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies and the
 //!   fault kinds (from the `bearing-signal` crate, shared with `firmware-sim`).
 //! - [`machine_fault`]: the machine faults beside the bearing (unbalance, misalignment,

@@ -19,6 +19,12 @@ use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
+pub mod detect;
+mod velocity;
+
+pub use detect::DetectorMessage;
+pub use velocity::{VelocityFlagMessage, VelocityMessage, ISO_ZONE_FLAG, VELOCITY_FLAG_NAME};
+
 /// Implements `Display` as the variant's wire name (`name()`), so text output and the log agree.
 macro_rules! display_as_name {
     ($($kind:ty),*) => {$(
@@ -407,44 +413,6 @@ pub struct HealthMessage {
     pub detail: String,
 }
 
-/// How status lines, the command line and alerts name the velocity zone flag (beside the
-/// fault kinds' names).
-pub const VELOCITY_FLAG_NAME: &str = "iso_zone";
-
-/// The ISO 10816-3 / 20816-3 velocity severity of the last few windows (every half window of
-/// the velocity analysis: 0.64 s at 25.6 kHz). Topic `/velocity/<sensor>/<axis>`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct VelocityMessage {
-    pub channel: ChannelId,
-    pub end_sample: u64,
-    /// Velocity RMS in the band, mm/s, integrated from the acceleration and averaged over
-    /// `windows_averaged` windows.
-    pub rms_mm_s: f64,
-    /// The zone of `rms_mm_s` for the configured machine group and foundation.
-    pub zone: IsoZone,
-    /// The standard's band, Hz: [10, 1000], or [2, 1000] below 600 rpm.
-    pub band_hz: [f64; 2],
-    pub windows_averaged: usize,
-    /// The zone flag's level after this reading (`watch` from zone C, `alarm` from zone D, with
-    /// the fault flags' hysteresis and delays).
-    pub flag: FlagLevel,
-}
-
-/// The velocity zone flag changed state. Topic `/velocity_flags/<sensor>/<axis>`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct VelocityFlagMessage {
-    pub channel: ChannelId,
-    pub end_sample: u64,
-    pub from: FlagLevel,
-    pub to: FlagLevel,
-    /// Velocity RMS, mm/s, and its zone, of the reading that changed the flag.
-    pub rms_mm_s: f64,
-    pub zone: IsoZone,
-    /// The zone boundaries the flag is judged against, mm/s: B/C (watch) and C/D (alarm).
-    pub watch_mm_s: f64,
-    pub alarm_mm_s: f64,
-}
-
 /// The shaft speed a channel uses from `end_sample` on (every speed frame, every estimate).
 /// Topic `/speed/<sensor>/<axis>`. A replay feeds the measured ones (`source = "can"`) back at
 /// their samples, so its flags equal the live run's.
@@ -499,8 +467,8 @@ pub enum PipelineMessage {
     Health(HealthMessage),
     Ingest(IngestMessage),
     Speed(SpeedMessage),
-    Velocity(VelocityMessage),
-    VelocityFlag(VelocityFlagMessage),
+    /// A registered detector's reading or flag change (ISO velocity, …): see [`detect`].
+    Detector(DetectorMessage),
 }
 
 /// What happened to the alert of one (channel, flag).
@@ -551,20 +519,23 @@ impl AlertState {
     }
 }
 
-/// Which flag an alert is about: a fault kind's, or the ISO velocity zone's.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+/// Which flag an alert is about: a bearing fault kind's, or a registered detector's (the ISO
+/// velocity zone, …).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum AlertSubject {
     Fault(FaultKind),
-    IsoZone,
+    Detector(&'static detect::FlagSpec),
 }
 
 impl AlertSubject {
-    /// The wire name: a fault kind's (`outer_race`, …) or `iso_zone`.
+    /// The ISO velocity zone flag's subject.
+    pub const ISO_ZONE: AlertSubject = AlertSubject::Detector(&ISO_ZONE_FLAG);
+
+    /// The wire name: a fault kind's (`outer_race`, …) or the detector flag's (`iso_zone`).
     pub fn name(self) -> &'static str {
         match self {
             AlertSubject::Fault(fault) => fault.name(),
-            AlertSubject::IsoZone => VELOCITY_FLAG_NAME,
+            AlertSubject::Detector(flag) => flag.name,
         }
     }
 }
@@ -573,7 +544,7 @@ impl AlertSubject {
 /// the flag's message: numbered, with its confidence. Not logged (the MCAP log has the flag
 /// itself, and the alert follows from it); the iceoryx2 publisher stamps the wall time and
 /// sends it (`docs/ALERTS.md`), the fleet bridge takes its confidence.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct AlertMessage {
     /// 1 for the first alert of a run, +1 for each next one.
     pub sequence: u64,

@@ -13,6 +13,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 
 use bearingd::mcap_log::{self, read_messages, read_raw_blocks};
+use bearingd::messages::detect::Emitted;
 use bearingd::messages::*;
 use bearingd::sinks::mcap::{
     self as mcap_sink, is_finished, recover_directory, LoggerConfig, McapLogger,
@@ -179,7 +180,7 @@ fn every_type() -> Vec<PipelineMessage> {
             given_rpm: None,
             rpm: None,
         }),
-        PipelineMessage::Velocity(VelocityMessage {
+        PipelineMessage::from(VelocityMessage {
             channel: ch("motor-de", "radial"),
             end_sample: 32_768,
             rms_mm_s: 3.745,
@@ -188,7 +189,7 @@ fn every_type() -> Vec<PipelineMessage> {
             windows_averaged: 1,
             flag: FlagLevel::Ok,
         }),
-        PipelineMessage::VelocityFlag(VelocityFlagMessage {
+        PipelineMessage::from(VelocityFlagMessage {
             channel: ch("motor-de", "radial"),
             end_sample: 163_840,
             from: FlagLevel::Ok,
@@ -214,8 +215,13 @@ fn topic_and_json(m: &PipelineMessage) -> (String, String) {
         PipelineMessage::Health(s) => (format!("/health/{}", s.channel), j(s)),
         PipelineMessage::Ingest(s) => (format!("/ingest/{}", s.source), j(s)),
         PipelineMessage::Speed(s) => (format!("/speed/{}", s.channel), j(s)),
-        PipelineMessage::Velocity(s) => (format!("/velocity/{}", s.channel), j(s)),
-        PipelineMessage::VelocityFlag(s) => (format!("/velocity_flags/{}", s.channel), j(s)),
+        // Written out, not taken from the registry: the ISO wire is the one it always was.
+        PipelineMessage::Detector(DetectorMessage::Velocity(Emitted::Reading(s))) => {
+            (format!("/velocity/{}", s.channel), j(s))
+        }
+        PipelineMessage::Detector(DetectorMessage::Velocity(Emitted::Flag(s))) => {
+            (format!("/velocity_flags/{}", s.channel), j(s))
+        }
     }
 }
 

@@ -56,18 +56,18 @@ impl Sink for FlagPrinter {
                 f.fault_frequency_hz,
                 f.end_sample
             ),
-            PipelineMessage::VelocityFlag(f) => println!(
-                "FLAG {}: {} {} -> {} (ISO velocity {:.2} mm/s, zone {}; C from {}, D from {} mm/s) at sample {}",
-                f.channel,
-                crate::messages::VELOCITY_FLAG_NAME,
-                f.from,
-                f.to,
-                f.rms_mm_s,
-                f.zone,
-                f.watch_mm_s,
-                f.alarm_mm_s,
-                f.end_sample
-            ),
+            PipelineMessage::Detector(m) => {
+                if let Some(f) = m.as_flag() {
+                    let (from, to) = f.change();
+                    println!(
+                        "FLAG {}: {} {from} -> {to} ({}) at sample {}",
+                        f.channel(),
+                        f.flag().name,
+                        f.evidence(),
+                        f.end_sample()
+                    );
+                }
+            }
             PipelineMessage::Health(h) if h.kind != HealthKind::Bands => {
                 println!(
                     "HEALTH {}: {} at sample {}",

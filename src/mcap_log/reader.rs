@@ -286,8 +286,7 @@ fn decode_json(kind: JsonKind, data: &[u8]) -> serde_json::Result<PipelineMessag
         JsonKind::Health => PipelineMessage::Health(serde_json::from_slice(data)?),
         JsonKind::Ingest => PipelineMessage::Ingest(serde_json::from_slice(data)?),
         JsonKind::Speed => PipelineMessage::Speed(serde_json::from_slice(data)?),
-        JsonKind::Velocity => PipelineMessage::Velocity(serde_json::from_slice(data)?),
-        JsonKind::VelocityFlag => PipelineMessage::VelocityFlag(serde_json::from_slice(data)?),
+        JsonKind::Detector(kind) => PipelineMessage::Detector((kind.info().decode)(data)?),
     })
 }
 

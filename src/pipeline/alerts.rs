@@ -13,9 +13,10 @@
 
 use crate::analysis::diagnosis::{score_evidence, DecisionRule};
 use crate::analysis::AnalysisSettings;
+use crate::messages::detect::{all_flags, FlagRecord};
 use crate::messages::{
     AlertMessage, AlertState, AlertSubject, ChannelId, FaultKind, FlagLevel, FlagMessage,
-    PipelineMessage, TwinMessage, VelocityFlagMessage,
+    PipelineMessage, TwinMessage,
 };
 use crate::twin::diagnose::twin_adjusted_confidence;
 use std::collections::{BTreeMap, HashMap};
@@ -25,10 +26,10 @@ use super::Output;
 /// Passes `output` on; after a flag change, the alerts it decides: the pipeline's outputs as
 /// its sinks see them.
 pub(super) fn pass_on(alerts: &mut AlertTracker, output: Output, out: &mut impl FnMut(Output)) {
-    let Output::Message(flag @ (PipelineMessage::Flag(_) | PipelineMessage::VelocityFlag(_))) =
-        &output
-    else {
-        return out(output);
+    let flag = match &output {
+        Output::Message(m @ PipelineMessage::Flag(_)) => m,
+        Output::Message(m @ PipelineMessage::Detector(d)) if d.as_flag().is_some() => m,
+        _ => return out(output),
     };
     let mut decided = Vec::with_capacity(1);
     alerts.observe(flag, &mut |alert| decided.push(alert));
@@ -63,10 +64,10 @@ pub struct AlertTracker {
 type AlertKey = (ChannelId, AlertSubject);
 
 /// History an alert service needs for `channels` analysed channels: room for every flag of
-/// every channel (four faults and the velocity zone) to be active twice over, so repeats stay
-/// rare.
+/// every channel (four faults and every detector's flags) to be active twice over, so repeats
+/// stay rare.
 pub fn history_size_for(channels: usize) -> usize {
-    (2 * (FaultKind::ALL.len() + 1) * channels).max(16)
+    (2 * (FaultKind::ALL.len() + all_flags().count()) * channels).max(16)
 }
 
 impl AlertTracker {
@@ -109,7 +110,10 @@ impl AlertTracker {
                 return;
             }
             PipelineMessage::Flag(flag) => self.fault_alert(flag),
-            PipelineMessage::VelocityFlag(flag) => self.zone_alert(flag),
+            PipelineMessage::Detector(m) => match m.as_flag() {
+                Some(flag) => self.detector_alert(flag),
+                None => return,
+            },
             _ => return,
         };
         self.emit(alert, emit);
@@ -159,17 +163,17 @@ impl AlertTracker {
         }
     }
 
-    /// The alert of a velocity zone flag: a measurement against the standard's boundary, not
-    /// a hypothesis, so its confidence is 1.
-    fn zone_alert(&self, flag: &VelocityFlagMessage) -> AlertMessage {
+    /// The alert of a detector's flag: score and confidence as the detector gives them (the
+    /// velocity zone: its RMS, and 1 for a measurement against the standard's boundary).
+    fn detector_alert(&self, flag: &dyn FlagRecord) -> AlertMessage {
         AlertMessage {
-            score: flag.rms_mm_s,
-            confidence: 1.0,
+            score: flag.score(),
+            confidence: flag.confidence(),
             ..self.change_alert(
-                &flag.channel,
-                flag.end_sample,
-                AlertSubject::IsoZone,
-                (flag.from, flag.to),
+                flag.channel(),
+                flag.end_sample(),
+                AlertSubject::Detector(flag.flag()),
+                flag.change(),
             )
         }
     }
@@ -454,7 +458,7 @@ mod tests {
     fn a_velocity_zone_flag_is_an_alert_of_its_own_beside_the_fault_alerts() {
         let mut t = tracker(16);
         let zone = |from, to, rms_mm_s, at| {
-            PipelineMessage::VelocityFlag(VelocityFlagMessage {
+            PipelineMessage::from(crate::messages::VelocityFlagMessage {
                 channel: ChannelId {
                     sensor: "motor-de".into(),
                     axis: "radial".into(),
@@ -470,7 +474,7 @@ mod tests {
         };
         observe(&mut t, &flag("radial", OuterRace, OK, Watch, 5));
         let raised = observe(&mut t, &zone(OK, Watch, 3.7, 10)).remove(0);
-        assert_eq!(raised.subject, AlertSubject::IsoZone);
+        assert_eq!(raised.subject, AlertSubject::ISO_ZONE);
         assert_eq!((raised.state, raised.severity), (AlertState::Raised, Watch));
         assert_eq!((raised.score, raised.confidence), (3.7, 1.0));
         assert_eq!((raised.fault_frequency_hz, raised.twin_error), (None, None));

@@ -35,11 +35,12 @@ use crate::analysis::speed::{SpeedMode, SpeedSearch};
 use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
 use crate::config::{Config, SensorConfig, Speed};
+use crate::messages::detect::{all_flags, FlagRecord};
 use crate::messages::{
     AlertMessage, ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage,
     HealthStage, IndicatorsMessage, IngestMessage, IsoZone, PipelineMessage, RawBlock,
     SpectrumMessage, SpeedMessage, SpeedSource, TrendMessage, TwinMessage, VelocityFlagMessage,
-    VelocityMessage, VELOCITY_FLAG_NAME,
+    VelocityMessage, ISO_ZONE_FLAG,
 };
 use alerts::{history_size_for, pass_on, AlertTracker};
 use serde::Serialize;
@@ -139,8 +140,9 @@ pub struct ChannelStatus {
     /// The latest ISO velocity RMS (mm/s) and its zone; `None` before the first reading.
     pub velocity_mm_s: Option<f64>,
     pub zone: Option<IsoZone>,
-    /// The velocity zone flag (watch in zone C, alarm in zone D).
-    pub zone_flag: FlagLevel,
+    /// Every registered detector's flags by name, in registry order (the velocity zone flag
+    /// `iso_zone`: watch in zone C, alarm in zone D).
+    pub detector_flags: Vec<(&'static str, FlagLevel)>,
 }
 
 impl ChannelStatus {
@@ -151,7 +153,11 @@ impl ChannelStatus {
             .iter()
             .map(|f| f.name())
             .zip(&self.flags)
-            .chain([(VELOCITY_FLAG_NAME, &self.zone_flag)])
+            .chain(
+                self.detector_flags
+                    .iter()
+                    .map(|(name, level)| (*name, level)),
+            )
             .filter(|(_, level)| **level != FlagLevel::Ok)
             .map(|(fault, level)| format!("{fault}={level}"))
             .collect();
@@ -159,6 +165,15 @@ impl ChannelStatus {
             "ok".to_string()
         } else {
             raised.join(",")
+        }
+    }
+
+    /// Sets the level of the detector flag `name`.
+    fn set_detector_flag(&mut self, name: &str, to: FlagLevel) {
+        for (flag, level) in &mut self.detector_flags {
+            if *flag == name {
+                *level = to;
+            }
         }
     }
 }
@@ -371,7 +386,7 @@ impl Pipeline {
                     flag_changes: 0,
                     velocity_mm_s: None,
                     zone: None,
-                    zone_flag: FlagLevel::Ok,
+                    detector_flags: all_flags().map(|f| (f.name, FlagLevel::Ok)).collect(),
                 };
                 let fs_hz = sensor.sample_rate_hz;
                 channels.insert(
@@ -648,8 +663,8 @@ fn handle_event(
         } => {
             status.velocity_mm_s = Some(reading.rms_mm_s);
             status.zone = Some(reading.zone);
-            status.zone_flag = flag;
-            PipelineMessage::Velocity(VelocityMessage {
+            status.set_detector_flag(ISO_ZONE_FLAG.name, flag);
+            VelocityMessage {
                 channel: channel.clone(),
                 end_sample: reading.end_sample,
                 rms_mm_s: reading.rms_mm_s,
@@ -657,15 +672,15 @@ fn handle_event(
                 band_hz: [band_hz.0, band_hz.1],
                 windows_averaged: reading.windows_averaged,
                 flag,
-            })
+            }
+            .into()
         }
         MonitorEvent::VelocityFlag {
             change,
             reading,
             limits,
         } => {
-            status.zone_flag = change.to;
-            PipelineMessage::VelocityFlag(VelocityFlagMessage {
+            let flag = VelocityFlagMessage {
                 channel: channel.clone(),
                 end_sample: change.at_sample,
                 from: change.from,
@@ -674,7 +689,9 @@ fn handle_event(
                 zone: reading.zone,
                 watch_mm_s: limits.bc_mm_s,
                 alarm_mm_s: limits.cd_mm_s,
-            })
+            };
+            status.set_detector_flag(flag.flag().name, flag.change().1);
+            flag.into()
         }
         MonitorEvent::Trend { point, stage } => PipelineMessage::Trend(TrendMessage {
             channel: channel.clone(),

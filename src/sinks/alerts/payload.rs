@@ -8,7 +8,8 @@
 //! to the narrowest so there is no padding to get wrong.
 
 use crate::config::MAX_ID_LEN;
-use crate::messages::{AlertMessage, AlertSubject, FaultKind, FlagLevel};
+use crate::messages::detect::{all_flags, flag_by_code};
+use crate::messages::{AlertMessage, AlertSubject, FaultKind, FlagLevel, ISO_ZONE_FLAG};
 #[cfg(feature = "shm")]
 use iceoryx2::prelude::ZeroCopySend;
 use serde::Serialize;
@@ -37,26 +38,24 @@ pub fn fault_code(fault: FaultKind) -> u8 {
 
 /// Code in [`Alert::fault`] of the ISO velocity zone flag (watch in zone C, alarm in zone D):
 /// `score` is then the velocity RMS in mm/s, `fault_frequency_hz` and `twin_error` NaN.
-pub const ISO_ZONE_CODE: u8 = 5;
+pub const ISO_ZONE_CODE: u8 = ISO_ZONE_FLAG.code;
 
-/// Code in [`Alert::fault`] of the flag an alert is about.
+/// Code in [`Alert::fault`] of the flag an alert is about: a fault kind's, or the code a
+/// detector's flag declares (5 and up; `messages::detect`).
 pub fn subject_code(subject: AlertSubject) -> u8 {
     match subject {
         AlertSubject::Fault(fault) => fault_code(fault),
-        AlertSubject::IsoZone => ISO_ZONE_CODE,
+        AlertSubject::Detector(flag) => flag.code,
     }
 }
 
-/// The wire name of a code of [`Alert::fault`]: a fault kind's (`outer_race`, …) or
-/// `iso_zone`.
+/// The wire name of a code of [`Alert::fault`]: a fault kind's (`outer_race`, …) or a
+/// detector flag's (`iso_zone`, …).
 fn subject_of_code(code: u8) -> Option<&'static str> {
-    if code == ISO_ZONE_CODE {
-        return Some(crate::messages::VELOCITY_FLAG_NAME);
-    }
-    FaultKind::ALL
-        .into_iter()
-        .find(|f| fault_code(*f) == code)
+    let fault = FaultKind::ALL.into_iter().find(|f| fault_code(*f) == code);
+    fault
         .map(FaultKind::name)
+        .or_else(|| flag_by_code(code).map(|flag| flag.name))
 }
 
 /// Code of a flag level in [`Alert::severity`]: 0 ok, 1 watch, 2 alarm.
@@ -247,10 +246,10 @@ impl AlertView {
             self.previous_severity,
             self.severity
         );
-        if self.fault == crate::messages::VELOCITY_FLAG_NAME {
+        if let Some(flag) = all_flags().find(|flag| flag.name == self.fault) {
             return format!(
-                "{head}: ISO velocity {:.2} mm/s, t = {:.1} s",
-                self.score, self.sample_time_s
+                "{head}: {} {:.2} {}, t = {:.1} s",
+                flag.score_name, self.score, flag.unit, self.sample_time_s
             );
         }
         let twin = self.twin_error.map_or("no twin fit yet".to_string(), |e| {
@@ -376,7 +375,7 @@ mod tests {
         assert_eq!((view.fault_frequency_hz, view.sample_time_s), (162.0, 2.0));
         let zone = Alert::of_message(
             &AlertMessage {
-                subject: AlertSubject::IsoZone,
+                subject: AlertSubject::ISO_ZONE,
                 fault_frequency_hz: None,
                 ..message
             },

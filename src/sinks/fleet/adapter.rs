@@ -160,22 +160,17 @@ impl FleetSink {
                 },
             ),
             PipelineMessage::Speed(m) => (&m.channel, m.end_sample, Observed::Speed(m.rpm)),
-            // Every reading: the metrics go at the publish period, a new zone at once.
-            PipelineMessage::Velocity(m) => (
-                &m.channel,
-                m.end_sample,
-                Observed::IsoZone {
-                    zone: m.zone.name().to_string(),
-                    velocity_mm_s: m.rms_mm_s,
-                },
-            ),
-            // The zone flag follows the zone (the zone metric changes first, and at once); a
-            // fault flag goes with its alert, which comes right after it.
+            // Every detector reading: its metrics go at the publish period, an urgent one (a new
+            // ISO zone) at once. A detector's flag change has no metrics: its readings' follow
+            // it (the zone metric changes first, and at once).
+            PipelineMessage::Detector(m) => {
+                (m.channel(), m.end_sample(), Observed::of_detector(m)?)
+            }
+            // A fault flag goes with its alert, which comes right after it.
             PipelineMessage::Raw(_)
             | PipelineMessage::Spectrum(_)
             | PipelineMessage::Ingest(_)
-            | PipelineMessage::Flag(_)
-            | PipelineMessage::VelocityFlag(_) => return None,
+            | PipelineMessage::Flag(_) => return None,
         };
         Some(Observation {
             device: *self.channels.get(channel)?,

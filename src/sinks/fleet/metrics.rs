@@ -12,6 +12,7 @@
 //!   health stage or the sensor's presence changes (those must never wait for the period).
 
 use super::sparkplug::{DataType, Metric, Payload, Value};
+use crate::messages::detect::{all_metrics, MetricKind, MetricValue, METRIC_COUNT};
 use crate::messages::{FaultKind, FlagLevel, HealthStage};
 
 /// One device's identity: `<sensor>.<axis>` (Sparkplug ids must not hold `/`, `+`, `#`; sensor
@@ -77,9 +78,25 @@ pub enum Observed {
     Speed(Option<f64>),
     /// The sensor went silent (`true`) or came back.
     SensorLost(bool),
-    /// The ISO 20816 velocity zone (A–D) and the velocity RMS it rests on, when the pipeline
-    /// computes them.
-    IsoZone { zone: String, velocity_mm_s: f64 },
+    /// A detector's reading (the ISO 20816 velocity zone and RMS, …): values by index in
+    /// `messages::detect::all_metrics` (`None`: not a finite number).
+    Detector(Vec<(usize, Option<Value>)>),
+}
+
+impl Observed {
+    /// The metrics of a detector's reading; `None` when it has none (a flag change: its alert
+    /// carries it).
+    pub fn of_detector(message: &crate::messages::DetectorMessage) -> Option<Observed> {
+        let mut values = Vec::new();
+        message.metrics(&mut |index, value| {
+            let value = match value {
+                MetricValue::Text(text) => Some(Value::String(text.to_string())),
+                MetricValue::Double(x) => x.is_finite().then_some(Value::Double(x)),
+            };
+            values.push((index, value));
+        });
+        (!values.is_empty()).then_some(Observed::Detector(values))
+    }
 }
 
 /// The metric catalog of a device, in the order of [`Slot`]s.
@@ -95,20 +112,19 @@ const RMS: usize = 3;
 const PEAK: usize = 4;
 const CREST: usize = 5;
 const KURTOSIS: usize = 6;
-const ISO_ZONE: usize = 7;
-const ISO_VELOCITY: usize = 8;
-const TWIN_HYPOTHESIS: usize = 9;
-const TWIN_ERROR: usize = 10;
-const TWIN_MARGIN: usize = 11;
-const TWIN_RESIDUAL_ENERGY: usize = 12;
-const TWIN_RESIDUAL_PEAK: usize = 13;
-const TWIN_ERRORS: usize = 14; // three: outer race, inner race, ball
-const HW_ACCURACY: usize = 17;
-const HW_RESIDUAL_DRIFT: usize = 18;
-const HW_PARAMETER_DRIFT: usize = 19;
-const TIME_TO_LIMIT: usize = 20;
-const TIME_TO_LIMIT_EARLIEST: usize = 21;
-const FAULTS: usize = 22; // per fault kind: flag, confidence, score
+const DETECTORS: usize = 7; // every registered detector's metrics, METRIC_COUNT of them
+const TWIN_HYPOTHESIS: usize = DETECTORS + METRIC_COUNT;
+const TWIN_ERROR: usize = TWIN_HYPOTHESIS + 1;
+const TWIN_MARGIN: usize = TWIN_HYPOTHESIS + 2;
+const TWIN_RESIDUAL_ENERGY: usize = TWIN_HYPOTHESIS + 3;
+const TWIN_RESIDUAL_PEAK: usize = TWIN_HYPOTHESIS + 4;
+const TWIN_ERRORS: usize = TWIN_HYPOTHESIS + 5; // three: outer race, inner race, ball
+const HW_ACCURACY: usize = TWIN_HYPOTHESIS + 8;
+const HW_RESIDUAL_DRIFT: usize = TWIN_HYPOTHESIS + 9;
+const HW_PARAMETER_DRIFT: usize = TWIN_HYPOTHESIS + 10;
+const TIME_TO_LIMIT: usize = TWIN_HYPOTHESIS + 11;
+const TIME_TO_LIMIT_EARLIEST: usize = TWIN_HYPOTHESIS + 12;
+const FAULTS: usize = TWIN_HYPOTHESIS + 13; // per fault kind: flag, confidence, score
 const PER_FAULT: usize = 3;
 
 impl Catalog {
@@ -122,25 +138,37 @@ impl Catalog {
             ("Vibration/Peak_g", Double),
             ("Vibration/Crest", Double),
             ("Vibration/Kurtosis", Double),
-            ("ISO20816/Zone", Text),
-            ("ISO20816/VelocityRMS_mm_s", Double),
-            ("Twin/Hypothesis", Text),
-            ("Twin/Error", Double),
-            ("Twin/Margin", Double),
-            ("Twin/ResidualEnergyRatio", Double),
-            ("Twin/ResidualPeak_Hz", Double),
-            ("Twin/Error/outer_race", Double),
-            ("Twin/Error/inner_race", Double),
-            ("Twin/Error/ball", Double),
-            ("HW/Accuracy", Double),
-            ("HW/ResidualDrift_sigma", Double),
-            ("HW/ParameterDrift", Double),
-            ("Health/TimeToLimit_s", Double),
-            ("Health/TimeToLimitEarliest_s", Double),
         ]
         .into_iter()
         .map(|(n, t)| (n.to_string(), t))
         .collect();
+        debug_assert_eq!(names.len(), DETECTORS);
+        names.extend(all_metrics().map(|m| {
+            let datatype = match m.kind {
+                MetricKind::Text => Text,
+                MetricKind::Double => Double,
+            };
+            (m.name.to_string(), datatype)
+        }));
+        names.extend(
+            [
+                ("Twin/Hypothesis", Text),
+                ("Twin/Error", Double),
+                ("Twin/Margin", Double),
+                ("Twin/ResidualEnergyRatio", Double),
+                ("Twin/ResidualPeak_Hz", Double),
+                ("Twin/Error/outer_race", Double),
+                ("Twin/Error/inner_race", Double),
+                ("Twin/Error/ball", Double),
+                ("HW/Accuracy", Double),
+                ("HW/ResidualDrift_sigma", Double),
+                ("HW/ParameterDrift", Double),
+                ("Health/TimeToLimit_s", Double),
+                ("Health/TimeToLimitEarliest_s", Double),
+            ]
+            .into_iter()
+            .map(|(n, t)| (n.to_string(), t)),
+        );
         debug_assert_eq!(names.len(), FAULTS);
         for fault in FaultKind::ALL {
             let f = fault.name();
@@ -266,7 +294,6 @@ impl MetricBook {
         let period = self.period_ms;
         let device = self.devices.get_mut(o.device)?;
         let at = o.at_ms;
-        let zone_before = device.slots[ISO_ZONE].value.clone();
         let mut set = |slot: usize, value: Option<Value>| {
             let s = &mut device.slots[slot];
             // NaN never equals itself: compare the bits so that a NaN does not count as news.
@@ -279,6 +306,7 @@ impl MetricBook {
                 s.changed = true;
             }
             s.at_ms = at;
+            !same
         };
         let double = |x: f64| x.is_finite().then_some(Value::Double(x));
         let mut urgent = false;
@@ -354,20 +382,19 @@ impl MetricBook {
                 set(TIME_TO_LIMIT, time_to_limit_s.and_then(double));
                 set(TIME_TO_LIMIT_EARLIEST, earliest_s.and_then(double));
             }
-            Observed::Speed(rpm) => set(RPM, rpm.and_then(double)),
+            Observed::Speed(rpm) => {
+                set(RPM, rpm.and_then(double));
+            }
             Observed::SensorLost(lost) => {
                 set(LOST, Some(Value::Boolean(lost)));
                 device.lost = lost;
                 urgent = true;
             }
-            Observed::IsoZone {
-                zone,
-                velocity_mm_s,
-            } => {
-                let changed_zone = zone_before != Some(Value::String(zone.clone()));
-                set(ISO_ZONE, Some(Value::String(zone)));
-                set(ISO_VELOCITY, double(velocity_mm_s));
-                urgent = changed_zone;
+            Observed::Detector(values) => {
+                for (index, value) in values {
+                    let changed = set(DETECTORS + index, value);
+                    urgent |= changed && all_metrics().nth(index).is_some_and(|spec| spec.urgent);
+                }
             }
         }
         device.urgent |= urgent;
@@ -547,10 +574,10 @@ mod tests {
         let iso = |zone: &str, at| Observation {
             device: 1,
             at_ms: at,
-            what: Observed::IsoZone {
-                zone: zone.into(),
-                velocity_mm_s: 2.0,
-            },
+            what: Observed::Detector(vec![
+                (0, Some(Value::String(zone.into()))),
+                (1, Some(Value::Double(2.0))),
+            ]),
         };
         assert!(book.observe(iso("B", 10)).is_some());
         assert!(

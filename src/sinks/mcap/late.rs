@@ -53,7 +53,8 @@ enum LateKind {
 
 fn late_kind(message: &PipelineMessage) -> Option<LateKind> {
     match message {
-        PipelineMessage::Flag(_) | PipelineMessage::VelocityFlag(_) => Some(LateKind::Flag),
+        PipelineMessage::Flag(_) => Some(LateKind::Flag),
+        PipelineMessage::Detector(m) if m.as_flag().is_some() => Some(LateKind::Flag),
         PipelineMessage::Health(_) => Some(LateKind::Health),
         _ => None,
     }

@@ -28,8 +28,10 @@ use crate::analysis::health::Baseline;
 use crate::config::Config;
 use crate::mcap_log::schema::{LogLevel, StateSnapshot};
 use crate::mcap_log::McapLogError;
+use crate::messages::detect::Emitted;
 use crate::messages::{
-    ChannelId, FlagMessage, HealthMessage, PipelineMessage, TwinMessage, VelocityFlagMessage,
+    ChannelId, DetectorMessage, FlagMessage, HealthMessage, PipelineMessage, TwinMessage,
+    VelocityFlagMessage,
 };
 use crate::pipeline::{Sink, SinkError};
 use std::collections::{BTreeMap, HashMap};
@@ -119,7 +121,8 @@ impl CurrentState {
             PipelineMessage::Twin(m) => {
                 self.twin.insert(m.channel.to_string(), m.clone());
             }
-            PipelineMessage::VelocityFlag(m) => {
+            // The snapshot's field for the ISO zone flag, which readers of `/state` know.
+            PipelineMessage::Detector(DetectorMessage::Velocity(Emitted::Flag(m))) => {
                 self.velocity_flags.insert(m.channel.to_string(), m.clone());
             }
             _ => {}
@@ -262,8 +265,7 @@ impl McapSink {
             PipelineMessage::Flag(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Health(m) => at(&m.channel.sensor, m.end_sample),
             PipelineMessage::Speed(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Velocity(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::VelocityFlag(m) => at(&m.channel.sensor, m.end_sample),
+            PipelineMessage::Detector(m) => at(&m.channel().sensor, m.end_sample()),
             PipelineMessage::Ingest(_) => self.last_ns,
         }
     }
