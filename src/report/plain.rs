@@ -397,6 +397,7 @@ mod tests {
             significance,
             slip: 0.0,
             sideband_score: None,
+            modulation: None,
             harmonics: Vec::new(),
             explained: None,
             named: false,
