@@ -122,6 +122,19 @@ impl FaultScore {
         self
     }
 
+    /// A score whose harmonics were found at `found_hz` on bins `bin_hz` wide (tests of the
+    /// decision).
+    #[cfg(test)]
+    pub(crate) fn with_found_peaks(mut self, bin_hz: f64, found_hz: &[f64]) -> Self {
+        self.bin_hz = bin_hz;
+        self.peak_count = self.peak_count.max(found_hz.len().min(MAX_HARMONICS));
+        for (k, (peak, &hz)) in self.peaks.iter_mut().zip(found_hz).enumerate() {
+            peak.order = k + 1;
+            peak.found_hz = hz;
+        }
+        self
+    }
+
     /// The comb's effect size `C = ln score` (0 when not scored).
     pub fn effect(&self) -> f64 {
         if self.score > 0.0 {
