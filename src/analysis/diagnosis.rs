@@ -387,7 +387,7 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
         }
     }
     if named.is_some() {
-        if let Some(rival) = ball_or_inner(best, scores, min_sig - 1.0) {
+        if let Some(rival) = ball_or_inner(best, scores, |s| rule.detected(s)) {
             return Diagnosis {
                 verdict: Verdict::BallOrInner,
                 confidence,
@@ -662,11 +662,17 @@ pub(crate) mod tests {
         // 105-like: a tall inner comb, the ball comb it feeds shows no cage-rate pattern.
         let d = pair_verdict((15.0, 14.7, 1.3), (4.9, 6.4, 0.1), (162.0, 141.0), 1.5);
         assert_eq!(d.verdict, Verdict::InnerRace, "{}", d.reason);
-        // The ball comb with cage-rate sidebands of its own beside it: either.
-        let d = pair_verdict((8.0, 20.0, 1.0), (3.0, 6.0, 3.5), (162.0, 141.0), 1.5);
+        // A detected ball comb with cage-rate sidebands of its own beside it: either.
+        let d = pair_verdict((20.0, 30.0, 1.0), (6.0, 6.0, 3.5), (162.0, 141.0), 1.5);
         assert_eq!(d.verdict, Verdict::BallOrInner, "{}", d.reason);
         assert!(d.reason.contains("own sidebands"), "{}", d.reason);
         // A leader not named stays none whatever its rival shows.
+        let d = pair_verdict((2.0, 2.5, 1.0), (1.9, 2.5, 3.5), (162.0, 141.0), 1.5);
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+        // A damaged ball on a 6205 at 0.6× speed: the machine's shaft-modulated nuisance makes
+        // an inner comb of 2.9 with shaft-rate sidebands beside it; the ball stands.
+        let d = pair_verdict((2.9, 6.0, 6.0), (13.0, 20.0, 1.0), (162.0, 141.0), 1.5);
+        assert_eq!(d.verdict, Verdict::Ball, "{}", d.reason);
         let d = pair_verdict((2.0, 2.5, 1.0), (1.9, 2.5, 3.5), (162.0, 141.0), 1.5);
         assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
         // 224-like: never the ball, never the pair.
