@@ -336,6 +336,24 @@ mod tests {
     }
 
     #[test]
+    fn a_pair_verdict_stands_and_the_witness_never_splits_it() {
+        let all = scores([(1.2, 0.5), (8.0, 20.0), (3.0, 6.0), (1.1, 0.2)]);
+        let envelope = Diagnosis {
+            verdict: Verdict::BallOrInner,
+            confidence: 0.9,
+            candidates: Verdict::BallOrInner.faults().to_vec(),
+            reason: "either".into(),
+            named: Some(Named::BySize),
+        };
+        let explained: Vec<FaultScore> = all[..1].iter().chain(&all[2..]).copied().collect();
+        for class in [FaultKind::InnerRace, FaultKind::Ball] {
+            let opinion = Some(opinion(Some(class), 0.99));
+            let decided = decide(&all, &explained, &envelope, &rule(), &LOOSE, opinion);
+            assert_eq!(decided, envelope);
+        }
+    }
+
+    #[test]
     fn without_agreement_or_with_the_envelopes_own_thresholds_decide_is_diagnose() {
         let rule = rule();
         let strict = Agreement {

@@ -21,6 +21,7 @@
 //! ([`Named::Agreed`]), is decided after this rule, by [`super::agreement::decide`].
 
 use super::fault_bands::FaultScore;
+use super::rolling_element::{ball_or_inner, rival_leads};
 use crate::messages::FaultKind;
 use serde::Serialize;
 
@@ -38,6 +39,10 @@ pub enum Verdict {
     /// cage through the load zone once per cage turn, makes a cage comb of its own, often the
     /// taller one).
     BallOrCage,
+    /// A damaged rolling element or an inner-race defect, and the evidence cannot say which:
+    /// both combs sit on the same lines and their sidebands point to neither, or each shows its
+    /// own pattern ([`super::rolling_element`]).
+    BallOrInner,
 }
 
 impl Verdict {
@@ -49,6 +54,7 @@ impl Verdict {
             Verdict::Ball => "ball",
             Verdict::Cage => "cage",
             Verdict::BallOrCage => "ball_or_cage",
+            Verdict::BallOrInner => "ball_or_inner",
         }
     }
 
@@ -69,8 +75,12 @@ impl Verdict {
             Verdict::Ball => &[FaultKind::Ball],
             Verdict::Cage => &[FaultKind::Cage],
             Verdict::BallOrCage => &[FaultKind::Ball, FaultKind::Cage],
+            Verdict::BallOrInner => &[FaultKind::InnerRace, FaultKind::Ball],
         }
     }
+
+    /// The verdicts that name two faults they cannot tell apart.
+    pub const PAIRS: [Verdict; 2] = [Verdict::BallOrCage, Verdict::BallOrInner];
 }
 
 impl From<FaultKind> for Verdict {
@@ -232,11 +242,12 @@ impl<'a> Contest<'a> {
 /// outer-race defect is met by balls the cage carries; a damaged ball is carried through the
 /// load zone once per cage turn, so its impacts swell and fade at FTF), often a taller one than
 /// their own, and it outlasts their own comb in noise; a damaged cage makes no race or ball
-/// comb.
+/// comb. And an inner-race or ball comb gives way to its rival when the two share their lines
+/// and the sidebands speak for the rival ([`rival_leads`]).
 pub fn leader<'a>(scores: &'a [FaultScore], rule: &DecisionRule) -> Option<&'a FaultScore> {
     let top = scores.iter().max_by(|a, b| a.score.total_cmp(&b.score))?;
     if top.fault != FaultKind::Cage {
-        return Some(top);
+        return Some(rival_leads(top, scores).unwrap_or(top));
     }
     let cause = scores
         .iter()
@@ -270,6 +281,24 @@ fn ball_behind_cage<'a>(scores: &'a [FaultScore], rule: &DecisionRule) -> Option
 /// everything at FTF, the ball comb's sideband spacing). 1.8 lies between them (their geometric
 /// middle).
 const BALL_BEHIND_CAGE_SCORE: f64 = 1.8;
+
+/// Why a rolling-element pair cannot be told apart, in a few words.
+fn pair_words(leader: &FaultScore, rival: &FaultScore) -> String {
+    let z = |s: &FaultScore| s.modulation.map_or(0.0, |m| m.contrast_z);
+    if super::rolling_element::shared_combs(leader, rival) {
+        format!(
+            "both combs sit on the same lines and their sidebands point to neither (contrast \
+             {:+.1})",
+            z(leader)
+        )
+    } else {
+        format!(
+            "each shows its own sidebands ({} contrast {:+.1})",
+            rival.fault.name(),
+            z(rival)
+        )
+    }
+}
 
 /// How far a fault's `score` is from the decision boundary on scores alone (the alert's view:
 /// its significance was checked when its flag rose), in log units (positive: a fault), and the
@@ -352,6 +381,24 @@ pub fn diagnose(scores: &[FaultScore], explained: &[FaultScore], rule: &Decision
                      10^-{:.1}): a damaged ball makes a cage comb too, so a rolling element or \
                      the cage",
                     ball.score, ball.significance
+                ),
+                named,
+            };
+        }
+    }
+    if named.is_some() {
+        if let Some(rival) = ball_or_inner(best, scores, |s| rule.detected(s)) {
+            return Diagnosis {
+                verdict: Verdict::BallOrInner,
+                confidence,
+                candidates: Verdict::BallOrInner.faults().to_vec(),
+                reason: format!(
+                    "{header} stands, but it cannot be told from the {} comb ({:.1}, p = \
+                     10^-{:.1}): {}, so a rolling element or the inner race",
+                    rival.fault.name(),
+                    rival.score,
+                    rival.significance,
+                    pair_words(best, rival)
                 ),
                 named,
             };
@@ -552,6 +599,89 @@ pub(crate) mod tests {
         assert_eq!(d.candidates, vec![FaultKind::Ball, FaultKind::Cage]);
         assert_eq!(d.verdict.faults(), &[FaultKind::Ball, FaultKind::Cage]);
         assert_eq!(d.verdict.fault(), None);
+    }
+
+    /// Inner race and ball at (score, significance, contrast z), found at `inner_hz` and
+    /// `ball_hz` (× k, 1 Hz bins); outer race and cage small. The diagnosis, with the others as
+    /// `explained` (the ball at `explained_ball` once the leader is explained: what shared lines
+    /// leave of it).
+    fn pair_verdict(
+        inner: (f64, f64, f64),
+        ball: (f64, f64, f64),
+        (inner_hz, ball_hz): (f64, f64),
+        explained_ball: f64,
+    ) -> Diagnosis {
+        let mut all = scores([(1.2, 0.5), (inner.0, inner.1), (ball.0, ball.1), (1.1, 0.2)]);
+        for (s, (z, hz)) in all[1..3]
+            .iter_mut()
+            .zip([(inner.2, inner_hz), (ball.2, ball_hz)])
+        {
+            let found: Vec<f64> = (1..=5).map(|k| k as f64 * hz).collect();
+            *s = s.with_found_peaks(1.0, &found);
+            s.modulation = Some(crate::analysis::modulation::Modulation {
+                own: 1.0,
+                other: 1.0,
+                contrast_z: z,
+            });
+        }
+        let rule = rule();
+        let top = leader(&all, &rule).expect("scored").fault;
+        let explained: Vec<FaultScore> = all
+            .iter()
+            .filter(|s| s.fault != top)
+            .map(|s| {
+                let mut s = *s;
+                if matches!(s.fault, FaultKind::InnerRace | FaultKind::Ball) {
+                    s.score = s.score.min(explained_ball);
+                }
+                s
+            })
+            .collect();
+        diagnose(&all, &explained, &rule)
+    }
+
+    #[test]
+    fn a_61804_tie_is_a_rolling_element_or_the_inner_race_never_a_coin_toss() {
+        // Shared lines, no sidebands either way (a uniform load): explaining the taller comb
+        // away leaves the other nothing, yet the two cannot be told apart.
+        let d = pair_verdict((5.4, 20.0, 0.4), (5.3, 20.0, -0.4), (221.0, 221.0), 1.0);
+        assert_eq!(d.verdict, Verdict::BallOrInner, "{}", d.reason);
+        assert_eq!(d.verdict.faults(), &[FaultKind::InnerRace, FaultKind::Ball]);
+        assert_eq!(d.verdict.fault(), None);
+        assert_eq!(d.verdict.name(), "ball_or_inner");
+        // Cage-rate sidebands on the shared lines: the ball leads and is named.
+        let d = pair_verdict((5.4, 20.0, -2.5), (5.3, 20.0, 2.5), (221.0, 221.0), 1.0);
+        assert_eq!(d.verdict, Verdict::Ball, "{}", d.reason);
+        // Shaft-rate sidebands: the inner race.
+        let d = pair_verdict((5.4, 20.0, 2.5), (5.3, 20.0, -2.5), (221.0, 221.0), 1.0);
+        assert_eq!(d.verdict, Verdict::InnerRace, "{}", d.reason);
+    }
+
+    #[test]
+    fn apart_combs_are_either_only_when_both_patterns_show_and_none_stays_none() {
+        // 105-like: a tall inner comb, the ball comb it feeds shows no cage-rate pattern.
+        let d = pair_verdict((15.0, 14.7, 1.3), (4.9, 6.4, 0.1), (162.0, 141.0), 1.5);
+        assert_eq!(d.verdict, Verdict::InnerRace, "{}", d.reason);
+        // A detected ball comb with cage-rate sidebands of its own beside it: either.
+        let d = pair_verdict((20.0, 30.0, 1.0), (6.0, 6.0, 3.5), (162.0, 141.0), 1.5);
+        assert_eq!(d.verdict, Verdict::BallOrInner, "{}", d.reason);
+        assert!(d.reason.contains("own sidebands"), "{}", d.reason);
+        // A leader not named stays none whatever its rival shows.
+        let d = pair_verdict((2.0, 2.5, 1.0), (1.9, 2.5, 3.5), (162.0, 141.0), 1.5);
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+        // A damaged ball on a 6205 at 0.6× speed: the machine's shaft-modulated nuisance makes
+        // an inner comb of 2.9 with shaft-rate sidebands beside it; the ball stands.
+        let d = pair_verdict((2.9, 6.0, 6.0), (13.0, 20.0, 1.0), (162.0, 141.0), 1.5);
+        assert_eq!(d.verdict, Verdict::Ball, "{}", d.reason);
+        let d = pair_verdict((2.0, 2.5, 1.0), (1.9, 2.5, 3.5), (162.0, 141.0), 1.5);
+        assert_eq!(d.verdict, Verdict::None, "{}", d.reason);
+        // 224-like: never the ball, never the pair.
+        let d = pair_verdict((4.3, 19.1, 3.7), (2.3, 3.2, 0.2), (162.0, 141.0), 1.5);
+        assert!(
+            !matches!(d.verdict, Verdict::Ball | Verdict::BallOrInner),
+            "{}",
+            d.reason
+        );
     }
 
     #[test]

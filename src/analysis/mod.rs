@@ -8,7 +8,8 @@
 //! - [`envelope`]: squared-envelope spectrum, batch (Welch) and rolling.
 //! - [`kurtogram`]: the band tree, spectral kurtosis, GK index, per-band spectra.
 //! - [`fault_bands`]: fault-frequency scores with slip tolerance and sidebands.
-//! - [`diagnosis`]: the verdict and its confidence.
+//! - [`modulation`]: shaft- or cage-rate sidebands around a comb's peaks (ball or inner race).
+//! - [`diagnosis`]: the verdict and its confidence; [`rolling_element`] its ball-or-inner-race part.
 //! - [`indicators`]: RMS, peak, crest factor, kurtosis.
 //! - [`record`]: all of the above over one whole record (`bearingd analyze`).
 //! - [`speed`]: the shaft speed estimated from the spectrum near a nominal speed.
@@ -32,8 +33,10 @@ pub mod indicators;
 pub mod iso;
 pub mod kurtogram;
 pub mod machine;
+pub mod modulation;
 pub mod monitor;
 pub mod record;
+pub mod rolling_element;
 pub mod settings;
 pub mod speed;
 

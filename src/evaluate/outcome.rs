@@ -44,7 +44,8 @@ impl Predicted {
 
     /// What the flags say, from the highest level each fault's flag reached (outer, inner,
     /// ball, cage): the one fault whose flag rose, none, the two of a verdict that cannot tell
-    /// them apart (a rolling element or the cage: ambiguous, as that verdict), or several.
+    /// them apart (a rolling element or the cage, or the inner race: ambiguous, as that
+    /// verdict), or several.
     pub fn of_flags(highest: [FlagLevel; 4]) -> Self {
         let raised: Vec<FaultKind> = FaultKind::ALL
             .into_iter()
@@ -55,7 +56,7 @@ impl Predicted {
         match raised.as_slice() {
             [] => Predicted::None,
             [kind] => Predicted::Fault(*kind),
-            both if both == Verdict::BallOrCage.faults() => Predicted::Ambiguous,
+            both if Verdict::PAIRS.iter().any(|pair| pair.faults() == both) => Predicted::Ambiguous,
             _ => Predicted::Several,
         }
     }
@@ -161,5 +162,32 @@ impl CaseResult {
         self.record
             .as_ref()
             .map_or(Predicted::None, |outcome| outcome.predicted)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_flags_of_a_pair_verdict_are_ambiguous_and_other_pairs_are_several() {
+        let (ok, alarm) = (FlagLevel::Ok, FlagLevel::Alarm);
+        // Outer, inner, ball, cage.
+        assert_eq!(
+            Predicted::of_flags([ok, alarm, alarm, ok]),
+            Predicted::Ambiguous
+        );
+        assert_eq!(
+            Predicted::of_flags([ok, ok, alarm, alarm]),
+            Predicted::Ambiguous
+        );
+        assert_eq!(
+            Predicted::of_flags([alarm, alarm, ok, ok]),
+            Predicted::Several
+        );
+        assert_eq!(
+            Predicted::of_verdict(Verdict::BallOrInner),
+            Predicted::Ambiguous
+        );
     }
 }

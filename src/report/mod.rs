@@ -18,6 +18,7 @@ use crate::analysis::diagnosis::{DecisionRule, Diagnosis, Verdict};
 use crate::analysis::fault_bands::HarmonicPeak;
 use crate::analysis::indicators::Indicators;
 use crate::analysis::iso::VelocitySeverity;
+use crate::analysis::modulation::Modulation;
 use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::bearing::BearingGeometry;
 use crate::learned::{Basis, Combined, LearnedOpinion};
@@ -92,6 +93,8 @@ pub struct HypothesisReport {
     /// The comb's fitted slip, relative.
     pub slip: f64,
     pub sideband_score: Option<f64>,
+    /// For an inner race or a ball: shaft-rate against cage-rate sidebands around its peaks.
+    pub modulation: Option<Modulation>,
     pub harmonics: Vec<HarmonicPeak>,
     /// What is left of it once the leading hypothesis's comb is explained away (`null` for the
     /// leader itself): what the verdict weighed it on.
@@ -447,6 +450,7 @@ impl AnalyzeReport {
                     significance: h.score.significance,
                     slip: h.score.slip,
                     sideband_score: h.score.sideband_score,
+                    modulation: h.score.modulation,
                     harmonics: h.score.peaks().to_vec(),
                     explained: explained(h.score.fault),
                     named: false,

@@ -65,6 +65,10 @@ fn named_by(verdict: Verdict) -> Option<Named> {
             what: "rolling element (ball) or cage",
             faults: verdict.faults().to_vec(),
         }),
+        Verdict::BallOrInner => Some(Named {
+            what: "rolling element (ball) or inner race",
+            faults: verdict.faults().to_vec(),
+        }),
     }
 }
 
@@ -397,6 +401,7 @@ mod tests {
             significance,
             slip: 0.0,
             sideband_score: None,
+            modulation: None,
             harmonics: Vec::new(),
             explained: None,
             named: false,

@@ -21,6 +21,7 @@ mod learned_infer;
 mod monitor;
 mod physics;
 mod replay;
+mod rolling_element;
 mod severity;
 mod speed;
 mod trend;

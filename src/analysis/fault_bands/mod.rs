@@ -23,6 +23,7 @@
 //! hypothesis with the winner's comb (harmonics, ±1–2·fr and, for a ball, ±1–2·FTF) removed,
 //! so a runner-up is judged only on evidence the winner does not explain.
 
+use super::modulation::{anchored_contrast, spacings, Modulation};
 use crate::bearing::FaultFrequencies;
 use crate::messages::FaultKind;
 use serde::Serialize;
@@ -63,6 +64,13 @@ pub struct FaultScore {
     pub slip: f64,
     /// Geometric-mean peak-to-floor ratio of the sidebands alone, for faults that have them.
     pub sideband_score: Option<f64>,
+    /// For an inner race or a ball: its own sideband spacing against the other's, around the
+    /// peaks the comb found ([`super::modulation`]).
+    pub modulation: Option<Modulation>,
+    /// The spectrum's bin width (0 when not scored): peaks of two combs within a bin of each
+    /// other are the same line.
+    #[serde(skip)]
+    bin_hz: f64,
     #[serde(skip)]
     peaks: [HarmonicPeak; MAX_HARMONICS],
     #[serde(skip)]
@@ -79,6 +87,8 @@ impl FaultScore {
             significance: 0.0,
             slip: 0.0,
             sideband_score: None,
+            modulation: None,
+            bin_hz: 0.0,
             peaks: [HarmonicPeak::default(); MAX_HARMONICS],
             peak_count: 0,
         }
@@ -86,6 +96,11 @@ impl FaultScore {
 
     pub fn peaks(&self) -> &[HarmonicPeak] {
         &self.peaks[..self.peak_count]
+    }
+
+    /// The width of the spectrum's bins it was scored on (0 when not scored).
+    pub fn bin_hz(&self) -> f64 {
+        self.bin_hz
     }
 
     /// Whether every harmonic of the comb but one stands at least `ratio` times its floor: a
@@ -103,6 +118,19 @@ impl FaultScore {
         for (k, (peak, &ratio)) in self.peaks.iter_mut().zip(ratios).enumerate() {
             peak.order = k + 1;
             peak.ratio = ratio;
+        }
+        self
+    }
+
+    /// A score whose harmonics were found at `found_hz` on bins `bin_hz` wide (tests of the
+    /// decision).
+    #[cfg(test)]
+    pub(crate) fn with_found_peaks(mut self, bin_hz: f64, found_hz: &[f64]) -> Self {
+        self.bin_hz = bin_hz;
+        self.peak_count = self.peak_count.max(found_hz.len().min(MAX_HARMONICS));
+        for (k, (peak, &hz)) in self.peaks.iter_mut().zip(found_hz).enumerate() {
+            peak.order = k + 1;
+            peak.found_hz = hz;
         }
         self
     }
@@ -483,6 +511,11 @@ impl FaultScorer {
         if spacing > 0.0 && side_n > 0 {
             result.sideband_score = Some((side_sum / side_n as f64).exp());
         }
+        result.bin_hz = bin;
+        result.modulation = spacings(fault, freqs).and_then(|pair| {
+            let found = result.peaks().iter().map(|p| p.found_hz);
+            anchored_contrast(excess, bin, prepared.spread, found, pair, freqs.ftf)
+        });
         result
     }
 }
