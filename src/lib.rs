@@ -6,7 +6,8 @@
 //! (`scripts/module_deps.py` checks this in CI, and that there is no import cycle).
 //!
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or turns typed errors
-//!   into messages for people.
+//!   into messages for people. Lab commands are handed to the `bearingd-lab` binary
+//!   (crates/bearingd-lab, which uses this library and is never linked into the service).
 //! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
 //!   SNR, speed and bearing through the real pipeline, and recordings of a manifest through
 //!   `analyze` and through the daemon's replay (`bearingd evaluate`). Above [`daemon`]: it
@@ -28,8 +29,9 @@
 //! - [`config`]: the TOML configuration, parsed raw then validated into typed settings (one file
 //!   per section), with every problem reported at once.
 //! - [`learned`]: the learned diagnosis (seed 001): a denoising autoencoder + 1-D CNN trained
-//!   only on synthetic records (`bearingd train`), run with candle; an extra opinion that the
-//!   envelope evidence must back (`analyze --learned`, `twin.learned_model`).
+//!   only on synthetic records (`bearingd train`, in the lab crate `bearingd-lab`), run here by a
+//!   plain forward pass; an extra opinion that the envelope evidence must back
+//!   (`analyze --learned`, `twin.learned_model`).
 //! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the
 //!   `bearing-iox` crate, shared with the publishers).
 //! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits),
