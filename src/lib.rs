@@ -34,10 +34,9 @@
 //!   (`analyze --learned`, `twin.learned_model`).
 //! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the
 //!   `bearing-iox` crate, shared with the publishers).
-//! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits),
-//!   the 6-DOF physics model and its calibration (`twin::physics`), the
-//!   Hammerstein–Wiener identification (`twin::hw`) and labelled synthetic data sets made with
-//!   either model (`twin::dataset`, `bearingd dataset`).
+//! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits)
+//!   and the Hammerstein–Wiener identification (`twin::hw`). The 6-DOF physics model, its
+//!   calibration and the labelled synthetic data sets are the lab's (`bearingd_lab::twin`).
 //! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
 //!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
 //!   cannot disagree.

@@ -1,8 +1,8 @@
-//! The lab commands seen from the service binary. Training, simulation, evaluation and the
-//! pictures live in a second binary, `bearingd-lab` (crates/bearingd-lab), so that the service
-//! a box runs does not link candle, the ODE solver or the plotting code. A user still types
-//! `bearingd evaluate ...`: the service replaces itself with `bearingd-lab` and the same
-//! arguments (`exec`, so the exit code and signals are the lab's own).
+//! The lab commands seen from the service binary. Training, simulation and the physics twin live
+//! in a second binary, `bearingd-lab` (crates/bearingd-lab; evaluation and the pictures follow),
+//! so that the service a box runs does not link candle or the ODE solver. A user still types
+//! `bearingd train ...`: the service replaces itself with `bearingd-lab` and the same arguments
+//! (`exec`, so the exit code and signals are the lab's own).
 
 use super::CliError;
 use clap::Args;
@@ -14,17 +14,14 @@ use std::process::Command;
 /// The lab binary's name, looked up beside the running `bearingd`, then on PATH.
 pub const LAB_BINARY: &str = "bearingd-lab";
 
-/// The commands `bearingd-lab` runs; `analyze` runs there too when it draws (`--plot`).
-pub const LAB_COMMANDS: &[&str] = &["train"];
+/// The commands `bearingd-lab` runs. (Issue 31 moves `evaluate`, `trend` and `analyze --plot`
+/// there next, with the plotting code; until then the service runs them itself.)
+pub const LAB_COMMANDS: &[&str] = &["simulate", "dataset", "train", "calibrate"];
 
 /// The lab command `args` (without the program name) asks for, if it asks for one.
 pub fn lab_command<S: AsRef<str>>(args: &[S]) -> Option<&'static str> {
     let first = args.first()?.as_ref();
-    if let Some(command) = LAB_COMMANDS.iter().find(|c| **c == first) {
-        return Some(command);
-    }
-    let draws = |arg: &S| arg.as_ref() == "--plot" || arg.as_ref().starts_with("--plot=");
-    (first == "analyze" && args.iter().any(draws)).then_some("analyze")
+    LAB_COMMANDS.iter().find(|c| **c == first).copied()
 }
 
 /// A lab command's arguments, handed to `bearingd-lab` unparsed (its `--help` included).
@@ -58,4 +55,21 @@ fn lab_binary() -> PathBuf {
         .and_then(|exe| exe.parent().map(|dir| dir.join(LAB_BINARY)))
         .filter(|beside| beside.is_file())
         .unwrap_or_else(|| PathBuf::from(LAB_BINARY))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lab_commands_go_to_the_lab_the_rest_stays() {
+        assert_eq!(lab_command(&["train", "--help"]), Some("train"));
+        assert_eq!(
+            lab_command(&["simulate", "--out", "x.csv"]),
+            Some("simulate")
+        );
+        assert_eq!(lab_command(&["analyze", "a.mat", "--plot", "x.png"]), None);
+        assert_eq!(lab_command(&["run", "--config", "train"]), None);
+        assert_eq!(lab_command::<&str>(&[]), None);
+    }
 }

@@ -8,20 +8,16 @@
 #[cfg(feature = "shm")]
 mod alerts;
 pub mod analyze;
-mod calibrate;
 mod config_cmd;
-mod dataset;
 mod evaluate;
 mod fleet_decode;
 mod hw_table;
-mod import;
+pub mod import;
 mod ingest;
 pub mod lab;
 mod replay;
 mod run;
-mod simulate;
 mod trend;
-mod twin_args;
 
 use clap::{Args, Parser, Subcommand};
 use std::process::ExitCode;
@@ -110,16 +106,17 @@ enum Command {
     /// time to the failure limit; text, JSON or a table, and a plot.
     Trend(trend::TrendArgs),
     /// Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV.
-    Simulate(simulate::SimulateArgs),
+    /// Runs in bearingd-lab.
+    Simulate(lab::LabArgs),
     /// Generate a labelled synthetic data set (signal model or physics twin) for learned
-    /// diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log.
-    Dataset(dataset::DatasetArgs),
+    /// diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log. Runs in bearingd-lab.
+    Dataset(lab::LabArgs),
     /// Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of
     /// `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab.
     Train(lab::LabArgs),
     /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
-    /// to a measured record; prints the parameters and the fit error, plots the spectra.
-    Calibrate(calibrate::CalibrateArgs),
+    /// to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab.
+    Calibrate(lab::LabArgs),
     /// Check a configuration file; lists every problem with its key and how to fix it.
     Validate {
         /// The TOML file to check.
@@ -171,12 +168,12 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run_command(&args),
         Command::Replay(args) => replay::run(&args),
         Command::Import(args) => import::run(&args),
-        Command::Simulate(args) => simulate::run(&args),
-        Command::Dataset(args) => dataset::run(&args),
+        Command::Simulate(_) => Err(lab::exec_lab("simulate")),
+        Command::Dataset(_) => Err(lab::exec_lab("dataset")),
         Command::Train(_) => Err(lab::exec_lab("train")),
         Command::Trend(args) => trend::run(&args),
         Command::Evaluate(args) => evaluate::run(&args),
-        Command::Calibrate(args) => calibrate::run(&args),
+        Command::Calibrate(_) => Err(lab::exec_lab("calibrate")),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),
