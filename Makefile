@@ -1,12 +1,16 @@
 # Installs bearingd as a systemd service. See docs/SYSTEMD.md.
 #
 #   make install                      build (cargo build --release --locked) and install under /usr
-#   make install BIN=path/to/bearingd install an already built binary (e.g. a static musl build)
+#                                     the service bearingd and the lab bearingd-lab
+#   make install-service              the service alone (edge boxes: no training, no plots)
+#   make install BIN=path/to/bearingd install an already built binary (e.g. a static musl build);
+#                                     LAB_BIN=path/to/bearingd-lab likewise for the lab
 #   make install DESTDIR=/srv/root    stage into another root (packaging, VM images)
 #   make uninstall                    remove what install put there (not the config, logs, user)
 #
 # What goes where (PREFIX=/usr by default):
-#   $(PREFIX)/bin/bearingd                         the binary
+#   $(PREFIX)/bin/bearingd                         the service binary
+#   $(PREFIX)/bin/bearingd-lab                     the lab binary (not with install-service)
 #   $(PREFIX)/lib/systemd/system/bearingd.service  the unit (paths rewritten if PREFIX != /usr)
 #   $(PREFIX)/lib/sysusers.d/bearingd.conf         the static system user and group `bearingd`
 #   $(PREFIX)/lib/tmpfiles.d/bearingd.conf         /dev/cpu_dma_latency writable by that group
@@ -28,27 +32,45 @@ DOCDIR ?= $(PREFIX)/share/doc/bearingd
 CONFDIR = /etc/bearingd
 CARGO ?= cargo
 INSTALL ?= install
-# An already built binary to install; empty: build target/release/bearingd with cargo.
+# Already built binaries to install; empty: build target/release/bearingd (and bearingd-lab)
+# with cargo.
 BIN ?=
+LAB_BIN ?=
 
 ifeq ($(BIN),)
 BINARY := target/release/bearingd
 else
 BINARY := $(BIN)
 endif
+ifeq ($(LAB_BIN),)
+LAB_BINARY := target/release/bearingd-lab
+else
+LAB_BINARY := $(LAB_BIN)
+endif
 
-.PHONY: all build install uninstall
+.PHONY: all build build-lab install install-service uninstall
 
-all: build
+all: build build-lab
 
 build:
 ifeq ($(BIN),)
-	$(CARGO) build --release --locked
+	$(CARGO) build --release --locked -p bearingd
 else
 	@test -x "$(BIN)" || { echo "make: BIN=$(BIN) is not an executable file" >&2; exit 1; }
 endif
 
-install: build
+build-lab:
+ifeq ($(LAB_BIN),)
+	$(CARGO) build --release --locked -p bearingd-lab
+else
+	@test -x "$(LAB_BIN)" || { echo "make: LAB_BIN=$(LAB_BIN) is not an executable file" >&2; exit 1; }
+endif
+
+# Both binaries: `bearingd evaluate ...` and the other lab commands run bearingd-lab.
+install: install-service build-lab
+	$(INSTALL) -D -m 0755 "$(LAB_BINARY)" "$(DESTDIR)$(BINDIR)/bearingd-lab"
+
+install-service: build
 	$(INSTALL) -D -m 0755 "$(BINARY)" "$(DESTDIR)$(BINDIR)/bearingd"
 	$(INSTALL) -d -m 0755 "$(DESTDIR)$(UNITDIR)"
 	sed -e 's|/usr/bin/bearingd|$(BINDIR)/bearingd|g' \
@@ -77,7 +99,7 @@ uninstall:
 	@if [ -z "$(DESTDIR)" ] && [ -d /run/systemd/system ] && systemctl is-enabled --quiet bearingd 2>/dev/null; then \
 	  echo "bearingd is enabled: systemctl disable --now bearingd first" >&2; exit 1; \
 	fi
-	rm -f "$(DESTDIR)$(BINDIR)/bearingd" "$(DESTDIR)$(UNITDIR)/bearingd.service" \
+	rm -f "$(DESTDIR)$(BINDIR)/bearingd" "$(DESTDIR)$(BINDIR)/bearingd-lab" "$(DESTDIR)$(UNITDIR)/bearingd.service" \
 	      "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf" "$(DESTDIR)$(TMPFILESDIR)/bearingd.conf" \
 	      "$(DESTDIR)$(DOCDIR)/SYSTEMD.md" \
 	      "$(DESTDIR)$(DOCDIR)/bearingd.toml.default"

@@ -8,9 +8,10 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 OUT=${1:-models/skf-6205-2rs.safetensors}
-BIN=${BEARINGD:-target/release/bearingd}
+# Data sets and training are lab commands: the lab binary (cargo build --release -p bearingd-lab).
+LAB=${BEARINGD_LAB:-target/release/bearingd-lab}
 WORK=target/learned-train
 rm -rf "$WORK" && mkdir -p "$WORK" "$(dirname "$OUT")"
-"$BIN" dataset --spec config/learned-train.toml --out "$WORK/signal"
-"$BIN" dataset --spec config/learned-train-physics.toml --out "$WORK/physics"
-"$BIN" train --dataset "$WORK/signal" --dataset "$WORK/physics" --epochs 30 --seed 1 --out "$OUT"
+"$LAB" dataset --spec config/learned-train.toml --out "$WORK/signal"
+"$LAB" dataset --spec config/learned-train-physics.toml --out "$WORK/physics"
+"$LAB" train --dataset "$WORK/signal" --dataset "$WORK/physics" --epochs 30 --seed 1 --out "$OUT"

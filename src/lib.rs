@@ -6,7 +6,8 @@
 //! (`scripts/module_deps.py` checks this in CI, and that there is no import cycle).
 //!
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or turns typed errors
-//!   into messages for people.
+//!   into messages for people. Lab commands are handed to the `bearingd-lab` binary
+//!   (crates/bearingd-lab, which uses this library and is never linked into the service).
 //! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
 //!   SNR, speed and bearing through the real pipeline, and recordings of a manifest through
 //!   `analyze` and through the daemon's replay (`bearingd evaluate`). Above [`daemon`]: it
@@ -28,14 +29,14 @@
 //! - [`config`]: the TOML configuration, parsed raw then validated into typed settings (one file
 //!   per section), with every problem reported at once.
 //! - [`learned`]: the learned diagnosis (seed 001): a denoising autoencoder + 1-D CNN trained
-//!   only on synthetic records (`bearingd train`), run with candle; an extra opinion that the
-//!   envelope evidence must back (`analyze --learned`, `twin.learned_model`).
+//!   only on synthetic records (`bearingd train`, in the lab crate `bearingd-lab`), run here by a
+//!   plain forward pass; an extra opinion that the envelope evidence must back
+//!   (`analyze --learned`, `twin.learned_model`).
 //! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the
 //!   `bearing-iox` crate, shared with the publishers).
-//! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits),
-//!   the 6-DOF physics model and its calibration (`twin::physics`), the
-//!   Hammerstein–Wiener identification (`twin::hw`) and labelled synthetic data sets made with
-//!   either model (`twin::dataset`, `bearingd dataset`).
+//! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits)
+//!   and the Hammerstein–Wiener identification (`twin::hw`). The 6-DOF physics model, its
+//!   calibration and the labelled synthetic data sets are the lab's (`bearingd_lab::twin`).
 //! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
 //!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
 //!   cannot disagree.

@@ -12,10 +12,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn bearingd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bearingd"))
-        .args(args)
-        .output()
-        .expect("run bearingd")
+    bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd"), args)
 }
 
 fn stderr_of(out: &Output) -> String {

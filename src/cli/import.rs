@@ -70,7 +70,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
 
 /// A refused setting or a log that cannot be opened is the input's (exit 2); a failed write is
 /// not.
-pub(super) fn raw_log_error(error: RawLogError) -> CliError {
+pub fn raw_log_error(error: RawLogError) -> CliError {
     match error {
         RawLogError::Settings(_) | RawLogError::Open(_) => CliError::input(error),
         RawLogError::Write(_) | RawLogError::Io { .. } => CliError::failure(error),

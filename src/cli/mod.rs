@@ -7,21 +7,17 @@
 
 #[cfg(feature = "shm")]
 mod alerts;
-mod analyze;
-mod calibrate;
+pub mod analyze;
 mod config_cmd;
-mod dataset;
 mod evaluate;
 mod fleet_decode;
 mod hw_table;
-mod import;
+pub mod import;
 mod ingest;
+pub mod lab;
 mod replay;
 mod run;
-mod simulate;
-mod train;
 mod trend;
-mod twin_args;
 
 use clap::{Args, Parser, Subcommand};
 use std::process::ExitCode;
@@ -110,16 +106,17 @@ enum Command {
     /// time to the failure limit; text, JSON or a table, and a plot.
     Trend(trend::TrendArgs),
     /// Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV.
-    Simulate(simulate::SimulateArgs),
+    /// Runs in bearingd-lab.
+    Simulate(lab::LabArgs),
     /// Generate a labelled synthetic data set (signal model or physics twin) for learned
-    /// diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log.
-    Dataset(dataset::DatasetArgs),
+    /// diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log. Runs in bearingd-lab.
+    Dataset(lab::LabArgs),
     /// Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of
-    /// `bearingd dataset`; writes a model file for `analyze --learned`.
-    Train(train::TrainArgs),
+    /// `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab.
+    Train(lab::LabArgs),
     /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
-    /// to a measured record; prints the parameters and the fit error, plots the spectra.
-    Calibrate(calibrate::CalibrateArgs),
+    /// to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab.
+    Calibrate(lab::LabArgs),
     /// Check a configuration file; lists every problem with its key and how to fix it.
     Validate {
         /// The TOML file to check.
@@ -145,7 +142,7 @@ enum Command {
 /// tool does, by SIGPIPE, instead of panicking in `println!`: Rust ignores SIGPIPE, so a write
 /// to a closed pipe is an error that `println!` turns into a panic. The daemon (`run`) keeps the
 /// error: its stdout may be a journal that restarts, and it must not die of that.
-fn end_quietly_on_a_closed_pipe() {
+pub fn end_quietly_on_a_closed_pipe() {
     #[allow(unsafe_code)]
     // SAFETY: setting a signal's disposition to its default is async-signal-safe and is done
     // before any thread is started.
@@ -155,6 +152,13 @@ fn end_quietly_on_a_closed_pipe() {
 }
 
 pub fn main() -> ExitCode {
+    let args: Vec<String> = std::env::args_os()
+        .skip(1)
+        .map(|arg| arg.to_string_lossy().into_owned())
+        .collect();
+    if let Some(command) = lab::lab_command(&args) {
+        return exit_code("bearingd", Err(lab::exec_lab(command)));
+    }
     let cli = Cli::parse();
     if !matches!(cli.command, Command::Run(_)) {
         end_quietly_on_a_closed_pipe();
@@ -164,12 +168,12 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run_command(&args),
         Command::Replay(args) => replay::run(&args),
         Command::Import(args) => import::run(&args),
-        Command::Simulate(args) => simulate::run(&args),
-        Command::Dataset(args) => dataset::run(&args),
-        Command::Train(args) => train::run(&args),
+        Command::Simulate(_) => Err(lab::exec_lab("simulate")),
+        Command::Dataset(_) => Err(lab::exec_lab("dataset")),
+        Command::Train(_) => Err(lab::exec_lab("train")),
         Command::Trend(args) => trend::run(&args),
         Command::Evaluate(args) => evaluate::run(&args),
-        Command::Calibrate(args) => calibrate::run(&args),
+        Command::Calibrate(_) => Err(lab::exec_lab("calibrate")),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),
@@ -177,10 +181,15 @@ pub fn main() -> ExitCode {
         #[cfg(feature = "shm")]
         Command::Alerts(args) => alerts::run(&args),
     };
+    exit_code("bearingd", result)
+}
+
+/// Prints a command's error as `PROGRAM: error: ...` and gives its exit code (both binaries).
+pub fn exit_code(program: &str, result: Result<(), CliError>) -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            eprintln!("bearingd: error: {}", error.message);
+            eprintln!("{program}: error: {}", error.message);
             ExitCode::from(error.code)
         }
     }

@@ -1,14 +1,14 @@
 //! The network's forward pass in plain f32, for using a trained model: the service needs only
 //! this (about 27,000 multiply-adds per output bin of the autoencoder, a fraction of a
 //! millisecond per segment), so it does not link the training library. Training keeps its own
-//! forward ([`super::network`], candle), and a test holds the two to the same probabilities.
+//! forward (`bearingd_lab::learned::network`, candle), and a test holds the two to the same probabilities.
 //!
 //! The layers, after seed 001: the denoising autoencoder (three 9-tap "same" convolutions,
 //! 1 → 8 → 8 → 1 channels, ReLU between), then the classifier (a 7-tap convolution to 16
 //! channels, ReLU, 2× max-pool; a 5-tap convolution 16 → 16, ReLU, 2× max-pool; a linear layer
 //! to 32 units, ReLU; a linear layer to the classes), then softmax.
 //!
-//! The sizes are defined here once; [`super::network`] builds the trainable network from them,
+//! The sizes are defined here once; `bearingd_lab::learned::network` builds the trainable network from them,
 //! so a model file's tensor names and shapes are the same for both.
 
 /// One convolution of the network: the name of its tensors (`NAME.weight` `[outputs, inputs,

@@ -7,11 +7,13 @@
 //! fault on less evidence but never overrules or replaces it.
 //!
 //! - [`features`]: the input (order spectrum of a segment), the same in training and use;
-//! - [`network`]: the autoencoder and the classifier, trainable (candle);
+//! - `bearingd_lab::learned::network`: the autoencoder and the classifier, trainable (candle,
+//!   in the lab crate);
 //! - [`infer`]: the same network's forward pass in plain f32, what a trained model runs;
 //! - [`file`]: reading a model file (safetensors layout), bounded, every flaw a clear error;
 //! - [`model`]: a trained model (weights + model card) and its opinion of a record;
-//! - [`train`]: training on a data set, seeded, and writing the model file;
+//! - `bearingd_lab::learned::train`: training on a data set, seeded, and writing the model file
+//!   (the lab crate: the service never trains);
 //! - [`combine`]: the model as that witness, and what the report says of the outcome.
 
 pub mod combine;
@@ -19,10 +21,7 @@ pub mod features;
 pub mod file;
 pub mod infer;
 pub mod model;
-pub mod network;
-pub mod train;
 
 pub use combine::{combined, Basis, Combined};
 pub use features::FeatureSettings;
-pub use model::{LearnedModel, LearnedOpinion, ModelCard, ModelError};
-pub use train::{train, EpochReport, Trained, TrainingError, TrainingSet, TrainingSettings};
+pub use model::{LearnedModel, LearnedOpinion, ModelCard, ModelError, TrainingSummary};

@@ -3,7 +3,7 @@
 //! for and is refused, with the fix, where it does not apply.
 //!
 //! Using a model needs no training library: the file is read by [`super::file`] and the
-//! network run by [`super::infer`]. Writing one is training's ([`super::train`]).
+//! network run by [`super::infer`]. Writing one is training's (`bearingd_lab::learned::train`).
 
 use super::features::FeatureSettings;
 use super::file::{FileError, ModelFile};
@@ -15,9 +15,9 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// The metadata key of the model card in the safetensors header.
-pub(super) const CARD_KEY: &str = "bearingd.model_card";
+pub const CARD_KEY: &str = "bearingd.model_card";
 /// The card's format; a file of another format is refused.
-pub(super) const CARD_FORMAT: u32 = 1;
+pub const CARD_FORMAT: u32 = 1;
 
 /// What a model is and how it was made.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -103,7 +103,7 @@ impl LearnedModel {
     /// A model of `card` whose weights are asked of `tensor(name, shape)`: a model file's, or
     /// a network's fresh from training (`file` says which). A tensor that is missing or does
     /// not fit the network makes it [`ModelError::NotAModel`].
-    pub(super) fn from_tensors(
+    pub fn from_tensors(
         card: ModelCard,
         file: String,
         mut tensor: impl FnMut(&str, &[usize]) -> Result<Vec<f32>, FileError>,

@@ -20,10 +20,7 @@ use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 fn bearingd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bearingd"))
-        .args(args)
-        .output()
-        .expect("run bearingd")
+    bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd"), args)
 }
 
 /// A one-second `--fast` run of the embedded default on `data`.

@@ -6,10 +6,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 pub fn bearingd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bearingd"))
-        .args(args)
-        .output()
-        .expect("run bearingd")
+    bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd"), args)
 }
 
 pub fn stderr(out: &Output) -> String {

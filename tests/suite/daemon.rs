@@ -10,10 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
 fn bearingd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bearingd"))
-        .args(args)
-        .output()
-        .expect("run bearingd")
+    bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd"), args)
 }
 
 /// What `tests/python/<script> FILE` prints (JSON), asserting that it succeeded.

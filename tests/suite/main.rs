@@ -17,7 +17,6 @@ mod hostile_files;
 mod hostile_logs;
 mod kinematics;
 mod learned;
-mod learned_infer;
 mod monitor;
 mod physics;
 mod replay;

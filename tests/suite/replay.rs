@@ -12,10 +12,7 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 fn bearingd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bearingd"))
-        .args(args)
-        .output()
-        .expect("run bearingd")
+    bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd"), args)
 }
 
 fn stderr_of(out: &Output) -> String {

@@ -2,7 +2,7 @@
 # bearingd as a real systemd service, end to end, in a qemu VM.
 #
 # A Debian 12 root (debootstrap minbase + systemd, cached under the work directory) gets
-# bearingd through `make install DESTDIR=<root> BIN=<static musl binary>`, its user through
+# bearingd through `make install-service DESTDIR=<root> BIN=<static musl binary>`, its user through
 # systemd-sysusers, a config whose only sensor is the in-process simulated one (outer-race
 # fault from 2 s of sample time), and `systemctl enable bearingd`. The root is booted as an
 # initramfs with systemd as PID 1 (rdinit=/lib/systemd/systemd) under qemu TCG. A oneshot probe
@@ -72,11 +72,11 @@ say "cargo build --release --locked (musl)"
 strip -o "$WORK/bearingd" "$ROOT/target/x86_64-unknown-linux-musl/release/bearingd"
 
 # 5. The VM's root: a fresh copy of the base, then installed as an administrator would.
-say "make install DESTDIR=<root> BIN=<musl binary>"
+say "make install-service DESTDIR=<root> BIN=<musl binary>"
 R=$WORK/root
 rm -rf "$R"
 cp -a "$WORK/base" "$R"
-make -s -C "$ROOT" install DESTDIR="$R" BIN="$WORK/bearingd" > "$WORK/install.log"
+make -s -C "$ROOT" install-service DESTDIR="$R" BIN="$WORK/bearingd" > "$WORK/install.log"
 install_ok=PASS install_detail=
 check_installed() {
   if [ ! -e "$R$1" ]; then install_ok=FAIL; install_detail+=" missing $1;"; fi
@@ -121,7 +121,7 @@ cpu_wakeup_latency_us = 50
 EOF
 install -m 0644 "$WORK/test.toml" "$R/etc/bearingd/bearingd.toml"
 # A second install (an upgrade) must keep the administrator's config.
-make -s -C "$ROOT" install DESTDIR="$R" BIN="$WORK/bearingd" >> "$WORK/install.log"
+make -s -C "$ROOT" install-service DESTDIR="$R" BIN="$WORK/bearingd" >> "$WORK/install.log"
 cmp -s "$WORK/test.toml" "$R/etc/bearingd/bearingd.toml" ||
   { install_ok=FAIL; install_detail+=" a second make install overwrote /etc/bearingd/bearingd.toml;"; }
 echo "VMTEST install: $install_ok ${install_detail:-binary, unit, sysusers.d, doc, config in place; config kept on re-install; user $(cat "$WORK/passwd.line" 2>/dev/null)}" \

@@ -281,3 +281,21 @@ pub fn noise(len: usize, mut seed: u64) -> Vec<u8> {
         })
         .collect()
 }
+
+/// Runs `program` (a binary of the workspace, e.g. `env!("CARGO_BIN_EXE_bearingd")`) with
+/// `args` and returns what it did. A lab command (`simulate`, `train`, `analyze --plot`, ...)
+/// that `bearingd` could not hand over because `bearingd-lab` is not built beside it fails the
+/// test here, saying how to build it: `cargo test -p bearingd` alone does not build the lab.
+pub fn run_binary(program: &str, args: &[&str]) -> std::process::Output {
+    let out = std::process::Command::new(program)
+        .args(args)
+        .output()
+        .unwrap_or_else(|error| panic!("cannot run {program}: {error}"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !stderr.contains("is a lab command: install bearingd-lab"),
+        "`bearingd {}` runs in bearingd-lab, which is not built beside {program}: run `cargo build --release -p bearingd-lab` first ({stderr})",
+        args.join(" ")
+    );
+    out
+}

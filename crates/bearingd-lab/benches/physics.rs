@@ -4,7 +4,7 @@
 //! - calibration: wall-clock time of a full `calibrate` (default budget) on the dev record
 //!   CWRU 130 (outer race 0.007 in, 0 HP), on all cores; target ≤ 10 s.
 //!
-//! Run: `cargo bench --bench physics`. A bench command rather than criterion: one calibration
+//! Run: `cargo bench -p bearingd-lab --bench physics`. A bench command rather than criterion: one calibration
 //! takes seconds, and what matters is the rate, not a confidence interval over microseconds.
 //! Without ../shared/data the calibration part says so and is skipped (CI=true: fails).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
@@ -14,8 +14,10 @@ use bearingd::analysis::AnalysisSettings;
 use bearingd::bearing::BearingGeometry;
 use bearingd::messages::FaultKind;
 use bearingd::recording::{read_recording, ReadOptions};
-use bearingd::twin::physics::{calibrate, CalibrationSettings, Dof, PhysicsModel, PhysicsParams};
 use bearingd::twin::SimulatedFault;
+use bearingd_lab::twin::physics::{
+    calibrate, CalibrationSettings, Dof, PhysicsModel, PhysicsParams,
+};
 use std::path::Path;
 use std::time::Instant;
 
@@ -88,7 +90,7 @@ fn main() {
     }
 
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data/cwru/12k_Drive_End_OR007@6_0_130.mat");
+        .join("../../../shared/data/cwru/12k_Drive_End_OR007@6_0_130.mat");
     let recording = match read_recording(&path, &ReadOptions::default()) {
         Ok(r) => r,
         Err(e) => {

@@ -2,8 +2,8 @@
 //! [`crate::learned`]) on a `bearingd dataset` output, printing each epoch's loss and
 //! accuracies, and writes the model file (weights and model card).
 
-use super::CliError;
 use crate::learned::{train, FeatureSettings, TrainingSet, TrainingSettings};
+use bearingd::cli::CliError;
 use clap::Args;
 use std::path::PathBuf;
 

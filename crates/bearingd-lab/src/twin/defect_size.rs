@@ -8,7 +8,7 @@
 //! drops as the ball runs into the defect's half-sine profile and recovers as it leaves, through
 //! masses, Hertz contacts and a resonator (docs/PHYSICS.md).
 //!
-//! The grid ([`full_grid`]) is what `cargo run --release --example defect_size_grid` prints
+//! The grid ([`full_grid`]) is what `cargo run --release -p bearingd-lab --example defect_size_grid` prints
 //! and docs/DIAGNOSIS.md §5 reports; [`ci_cases`] is the subset the test runs.
 
 use super::physics::{simulate, PhysicsError, PhysicsParams};

@@ -2,8 +2,8 @@
 //! outer and inner race, widths 0.1–1 mm, 1200 and 1797 rpm, 500 and 2000 N, resonance 3 and
 //! 15 kHz, 48 kHz, 2 s per record; one table per noise level.
 //!
-//!     cargo run --release --example defect_size_grid            # noise 0.05 g and 0.2 g
-//!     cargo run --release --example defect_size_grid -- 0.1      # another noise level, g
+//!     cargo run --release -p bearingd-lab --example defect_size_grid            # noise 0.05 g and 0.2 g
+//!     cargo run --release -p bearingd-lab --example defect_size_grid -- 0.1      # another noise level, g
 //!
 //! Prints a Markdown table (true width, estimate ± uncertainty or why none, the verdict) and
 //! the summary; the time to simulate and size the records is measured here, outside the
@@ -11,7 +11,7 @@
 
 use bearingd::analysis::defect_size::NotMeasured;
 use bearingd::bearing::FaultKind;
-use bearingd::twin::defect_size::{full_grid, summarize, SizingOutcome, WIDTHS_MM};
+use bearingd_lab::twin::defect_size::{full_grid, summarize, SizingOutcome, WIDTHS_MM};
 use rayon::prelude::*;
 use std::time::Instant;
 

@@ -5,11 +5,11 @@
 //! that `bearingd replay` reads as the daemon's own. Records are made on all cores, with a
 //! progress bar on a terminal.
 
-use super::import::raw_log_error;
-use super::CliError;
 use crate::bearing::BearingGeometry;
 use crate::sinks::mcap::raw_log::{write_raw_log, LogSignal, RawLog};
 use crate::twin::dataset::{DatasetRecord, DatasetSpec};
+use bearingd::cli::import::raw_log_error;
+use bearingd::cli::CliError;
 use clap::Args;
 use ndarray::{Array1, Array2};
 use rayon::prelude::*;

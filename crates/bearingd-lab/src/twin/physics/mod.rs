@@ -8,7 +8,7 @@
 //!
 //! ```no_run
 //! use bearingd::bearing::BearingGeometry;
-//! use bearingd::twin::physics::{simulate, PhysicsModel, PhysicsParams};
+//! use bearingd_lab::twin::physics::{simulate, PhysicsModel, PhysicsParams};
 //! use bearingd::twin::SimulatedFault;
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
 //! let bearing = BearingGeometry::from_catalog("skf-6205-2rs")?;
@@ -44,13 +44,15 @@
 //! - [`PhysicsModel`]: the same, streaming (`fill` block by block), with integration counters.
 //! - [`PhysicsError`]: every unusable parameter is named with its fix (`Invalid`); a model
 //!   that cannot be integrated says when and why (`Integration`). No panic on any input.
-//! - [`calibrate`]: fits `k_r`, `c_r`, `k_b` and the defect width to a measured record.
+//! - [`calibrate`]: fits `k_r`, `c_r`, `k_b` and the defect width to a measured record, by
+//!   [`evolve::differential_evolution`] (parallel, rayon).
 //!
 //! The model, the integrator and its accuracy, the calibration and the measured speed:
 //! docs/PHYSICS.md.
 
 mod calibrate;
 mod dynamics;
+pub mod evolve;
 mod model;
 mod params;
 

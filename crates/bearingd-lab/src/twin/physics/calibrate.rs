@@ -16,17 +16,16 @@
 //! golden-section search. 0 dB is a perfect fit.
 //!
 //! The search: differential evolution over the four parameters in log coordinates
-//! ([`crate::twin::optimize::differential_evolution`]), each generation's candidates simulated
+//! ([`super::evolve::differential_evolution`]), each generation's candidates simulated
 //! in parallel. Seed 001 used Beluga Whale Optimization at 27–175 s per iteration; here a whole
 //! calibration takes seconds (docs/PHYSICS.md has the measured times).
 
+use super::evolve::{differential_evolution, EvolutionProgress, EvolutionSettings};
 use super::model::simulate;
 use super::params::{hertz_contact_stiffness, PhysicsError, PhysicsParams};
 use crate::analysis::band::Band;
 use crate::analysis::envelope::{welch_power_spectrum, FftPlans};
-use crate::twin::optimize::{
-    differential_evolution, golden_section, EvolutionProgress, EvolutionSettings,
-};
+use crate::twin::optimize::golden_section;
 use crate::twin::SimulatedFault;
 use serde::Serialize;
 

@@ -4,7 +4,6 @@
 //! `bearingd simulate --model physics --calibrated FILE`.
 
 use super::twin_args::{DofArg, FaultArg};
-use super::{CliError, RecordingArgs};
 use crate::analysis::band::Band;
 use crate::analysis::record::analyze_record;
 use crate::analysis::AnalysisSettings;
@@ -14,6 +13,7 @@ use crate::plot::{self, Color, Figure, Series, Shade, SpectrumPanel};
 use crate::recording::read_recording;
 use crate::twin::physics::{calibrate, Calibration, CalibrationSettings, Dof, PhysicsParams};
 use crate::twin::SimulatedFault;
+use bearingd::cli::{CliError, RecordingArgs};
 use clap::Args;
 use std::path::PathBuf;
 use std::time::Instant;

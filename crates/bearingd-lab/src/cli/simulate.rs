@@ -4,11 +4,11 @@
 //! MODELS.md §5, optionally with parameters calibrated to a real machine).
 
 use super::twin_args::{DofArg, FaultArg, MachineFaultArg};
-use super::CliError;
 use crate::bearing::BearingGeometry;
 use crate::machine_fault::MachineFault;
 use crate::twin::physics::{PhysicsModel, PhysicsParams};
 use crate::twin::{Nuisance, SimulationParams, Simulator};
+use bearingd::cli::CliError;
 use clap::{Args, ValueEnum};
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;

@@ -1,13 +1,14 @@
 //! The plain-f32 forward pass a model runs with ([`bearingd::learned::infer`]) against the
-//! candle network it was trained as ([`bearingd::learned::network`]), on the shipped model:
+//! candle network it was trained as ([`bearingd_lab::learned::network`]), on the shipped model:
 //! the same probabilities (within 1e-5) and the same most probable class, segment by segment,
 //! on simulated records of every class and on the real CWRU records.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::envelope::FftPlans;
-use bearingd::learned::network::Network;
 use bearingd::learned::LearnedModel;
 use bearingd::recording::{read_recording, ReadOptions};
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
+use bearingd_lab::learned::network::Network;
 use bearingd_testdata::{read_manifest, repo_root, shared_data_dir};
 use candle_core::{DType, Device, Tensor};
 use candle_nn::VarBuilder;

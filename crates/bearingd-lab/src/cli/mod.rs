@@ -1,0 +1,53 @@
+//! The `bearingd-lab` command line: the lab commands, also reached as `bearingd <command>`
+//! (the service binary hands them over unparsed). Errors, exit codes (0 success, 2 bad input,
+//! 1 anything else) and the shared arguments are the service's own ([`bearingd::cli`]).
+
+mod calibrate;
+mod dataset;
+mod simulate;
+mod train;
+mod twin_args;
+
+use bearingd::cli::{end_quietly_on_a_closed_pipe, exit_code, CliError};
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "bearingd-lab",
+    version,
+    about = "The bearingd laboratory: training, simulation, the physics twin, evaluation and pictures."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV.
+    Simulate(simulate::SimulateArgs),
+    /// Generate a labelled synthetic data set (signal model or physics twin) for learned
+    /// diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log.
+    Dataset(dataset::DatasetArgs),
+    /// Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of
+    /// `bearingd dataset`; writes a model file for `analyze --learned`.
+    Train(train::TrainArgs),
+    /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
+    /// to a measured record; prints the parameters and the fit error, plots the spectra.
+    Calibrate(calibrate::CalibrateArgs),
+}
+
+/// Parses the command line, runs the command, prints errors, returns the exit code. Every lab
+/// command is a report or a batch job: a closed pipe ends it quietly, as any Unix tool.
+pub fn main() -> ExitCode {
+    let cli = Cli::parse();
+    end_quietly_on_a_closed_pipe();
+    let result: Result<(), CliError> = match cli.command {
+        Command::Simulate(args) => simulate::run(&args),
+        Command::Dataset(args) => dataset::run(&args),
+        Command::Train(args) => train::run(&args),
+        Command::Calibrate(args) => calibrate::run(&args),
+    };
+    exit_code("bearingd-lab", result)
+}

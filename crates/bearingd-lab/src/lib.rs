@@ -1,0 +1,30 @@
+//! bearingd-lab: the laboratory around the bearingd service, in its own crate and binary so
+//! that the service a box runs links none of it (no training library, no ODE solver, no
+//! plotting, no thread pool). It uses the service's library (`bearingd`) for everything the two
+//! share: the analysis, the twin's signal model, the messages, the offline analysis and the
+//! command line's errors and exit codes.
+//!
+//! # Layout
+//!
+//! The rooms, top to bottom: a room uses only rooms listed below it, never one above
+//! (`scripts/module_deps.py` checks this in CI, and that there is no import cycle).
+//!
+//! - [`cli`]: the `bearingd-lab` command line (`bearingd <lab command>` runs it too); the only
+//!   place of this crate that prints or exits.
+//! - [`learned`]: training the learned diagnosis (candle): the trainable network and the
+//!   training loop on a data set of [`twin::dataset`]; the service's `bearingd::learned` runs
+//!   what it writes.
+//! - [`twin`]: the physics twin (6-DOF contact model, ODE integration, its calibration by a
+//!   parallel differential evolution), the labelled synthetic data sets and the defect-size
+//!   check on the physics twin; the service's signal-model twin re-exported beside them.
+//!
+//! The service's rooms this crate's modules use by their usual paths (`crate::analysis`, ...),
+//! re-exported below: all of them sit under every room above.
+
+pub mod cli;
+pub mod learned;
+pub mod twin;
+
+pub use bearingd::{
+    analysis, bearing, clock, machine_fault, messages, offline, plot, random, recording, sinks,
+};
