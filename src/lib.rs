@@ -7,11 +7,8 @@
 //!
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or turns typed errors
 //!   into messages for people. Lab commands are handed to the `bearingd-lab` binary
-//!   (crates/bearingd-lab, which uses this library and is never linked into the service).
-//! - [`evaluate`]: the detector-evaluation harness: simulated faults swept over type, severity,
-//!   SNR, speed and bearing through the real pipeline, and recordings of a manifest through
-//!   `analyze` and through the daemon's replay (`bearingd evaluate`). Above [`daemon`]: it
-//!   replays imported recordings through it, as a user would.
+//!   (crates/bearingd-lab, which uses this library and is never linked into the service): training,
+//!   simulation, the physics twin and the detector evaluation (`bearingd evaluate`).
 //! - [`daemon`]: wiring only: `run` and `replay` lock the data dir, start sources, the pipeline
 //!   and sinks, and stop them; what happens is reported as typed events, never printed.
 //! - [`sources`]: SocketCAN, iceoryx2, the simulated sensor and MCAP replay → sample blocks in
@@ -66,7 +63,6 @@ pub mod cli;
 pub mod clock;
 pub mod config;
 pub mod daemon;
-pub mod evaluate;
 pub mod fsafe;
 pub mod iox;
 pub mod learned;

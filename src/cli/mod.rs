@@ -9,7 +9,6 @@
 mod alerts;
 pub mod analyze;
 mod config_cmd;
-mod evaluate;
 mod fleet_decode;
 mod hw_table;
 pub mod import;
@@ -100,7 +99,8 @@ enum Command {
     Replay(replay::ReplayArgs),
     /// Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records)
     /// through the real pipeline: detection probability, false alarms, confusion matrix, plot.
-    Evaluate(evaluate::EvaluateArgs),
+    /// Runs in bearingd-lab.
+    Evaluate(lab::LabArgs),
     /// Follow a bearing's life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs):
     /// health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its
     /// time to the failure limit; text, JSON or a table, and a plot.
@@ -172,7 +172,7 @@ pub fn main() -> ExitCode {
         Command::Dataset(_) => Err(lab::exec_lab("dataset")),
         Command::Train(_) => Err(lab::exec_lab("train")),
         Command::Trend(args) => trend::run(&args),
-        Command::Evaluate(args) => evaluate::run(&args),
+        Command::Evaluate(_) => Err(lab::exec_lab("evaluate")),
         Command::Calibrate(_) => Err(lab::exec_lab("calibrate")),
         Command::Validate { file } => config_cmd::validate(&file),
         Command::Config { action } => config_cmd::run(&action),

@@ -9,7 +9,6 @@ mod dataset;
 mod defect_size;
 mod developer_set;
 mod envelope;
-mod evaluate_recordings;
 mod fleet;
 mod formats;
 mod hostile_alerts;

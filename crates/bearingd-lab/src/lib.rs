@@ -11,6 +11,10 @@
 //!
 //! - [`cli`]: the `bearingd-lab` command line (`bearingd <lab command>` runs it too); the only
 //!   place of this crate that prints or exits.
+//! - [`evaluate`]: the detector-evaluation harness (`bearingd-lab evaluate`): simulated faults
+//!   swept over type, severity, SNR, speed and bearing through the real pipeline, hours of
+//!   healthy signal through the daemon's monitor, and recordings of a manifest through
+//!   `analyze` and through the daemon's replay (in-process, as `import` + `replay` would).
 //! - [`learned`]: training the learned diagnosis (candle): the trainable network and the
 //!   training loop on a data set of [`twin::dataset`]; the service's `bearingd::learned` runs
 //!   what it writes.
@@ -22,9 +26,11 @@
 //! re-exported below: all of them sit under every room above.
 
 pub mod cli;
+pub mod evaluate;
 pub mod learned;
 pub mod twin;
 
 pub use bearingd::{
-    analysis, bearing, clock, machine_fault, messages, offline, plot, random, recording, sinks,
+    analysis, bearing, clock, config, daemon, machine_fault, messages, offline, pipeline, plot,
+    random, recording, report, sinks, sources,
 };

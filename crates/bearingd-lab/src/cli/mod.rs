@@ -4,6 +4,7 @@
 
 mod calibrate;
 mod dataset;
+mod evaluate;
 mod simulate;
 mod train;
 mod twin_args;
@@ -36,6 +37,10 @@ enum Command {
     /// Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width)
     /// to a measured record; prints the parameters and the fit error, plots the spectra.
     Calibrate(calibrate::CalibrateArgs),
+    /// Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records)
+    /// through the real pipeline: detection probability, false alarms, confusion matrix, plot;
+    /// or real recordings of a manifest through `analyze` and through the daemon.
+    Evaluate(evaluate::EvaluateArgs),
 }
 
 /// Parses the command line, runs the command, prints errors, returns the exit code. Every lab
@@ -48,6 +53,7 @@ pub fn main() -> ExitCode {
         Command::Dataset(args) => dataset::run(&args),
         Command::Train(args) => train::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
+        Command::Evaluate(args) => evaluate::run(&args),
     };
     exit_code("bearingd-lab", result)
 }

@@ -1,6 +1,6 @@
-//! `bearingd evaluate`: the detector-evaluation harness (seed 002's method: a twin generates
-//! faults under controlled conditions, and the condition-monitoring algorithm is judged on
-//! them).
+//! `bearingd-lab evaluate` (or `bearingd evaluate`): the detector-evaluation harness (seed
+//! 002's method: a twin generates faults under controlled conditions, and the
+//! condition-monitoring algorithm is judged on them).
 //!
 //! Why: a detector tuned on a handful of recordings says nothing about the faults, speeds,
 //! bearings and noise levels it has not seen. The simulator knows the truth, so a sweep over

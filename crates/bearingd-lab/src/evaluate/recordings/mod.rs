@@ -43,7 +43,6 @@ use crate::analysis::AnalysisSettings;
 use crate::config::Config;
 use crate::daemon::events::{DaemonEvent, Events};
 use crate::daemon::{replay, ReplayOptions, RunStart};
-use crate::learned::{LearnedModel, ModelError};
 use crate::messages::{FaultKind, FlagLevel, HealthKind, PipelineMessage};
 use crate::offline::{analyze_recording, resolve_conditions, AnalyzeRequest};
 use crate::pipeline::{Sink, SinkError};
@@ -53,6 +52,7 @@ use crate::recording::{
 use crate::report::SpeedSource;
 use crate::sinks::mcap::raw_log::{import_recording, Import, LogSignal};
 use crate::sources::replay::plan::{LoggedSettings, ReplayPlan};
+use bearingd::learned::{LearnedModel, ModelError};
 use serde::Serialize;
 use std::io::Read;
 use std::path::{Path, PathBuf};

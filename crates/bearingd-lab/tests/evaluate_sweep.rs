@@ -1,4 +1,4 @@
-//! The CI sweep of `bearingd evaluate --quick` (issue 16, item 2): the real pipeline, both
+//! The CI sweep of `bearingd-lab evaluate --quick` (issue 16, item 2): the real pipeline, both
 //! paths (`analyze`'s verdict and the daemon's channel monitor), on simulated records of every
 //! fault type and of healthy bearings, with a machine's nuisance on.
 //!
@@ -8,9 +8,9 @@
 //! the calibrated decision (issue 16, item 1) lands. Do not loosen it to pass; the failure
 //! message lists every failing case with its scores, for tuning.
 
-use bearingd::evaluate::summary::{detected, is_confident_wrong};
-use bearingd::evaluate::{run_sweep, Bench, CaseResult, NoiseLevel, Path, Predicted, Sweep};
 use bearingd::twin::SimulatedFault;
+use bearingd_lab::evaluate::summary::{detected, is_confident_wrong};
+use bearingd_lab::evaluate::{run_sweep, Bench, CaseResult, NoiseLevel, Path, Predicted, Sweep};
 
 #[test]
 fn issue16_quick_sweep_flags_every_fault_and_no_healthy_bearing() {
@@ -97,7 +97,7 @@ fn the_sweep_is_deterministic_whatever_the_threads() {
     sweep.healthy_repeats = 1;
     let one = run_sweep(&bench, &sweep, 1, &|_, _| {});
     let two = run_sweep(&bench, &sweep, 2, &|_, _| {});
-    let csv = bearingd::evaluate::render_csv;
+    let csv = bearingd_lab::evaluate::render_csv;
     assert_eq!(csv(&one), csv(&two));
     assert_eq!(one.len(), 5);
 }
@@ -109,12 +109,14 @@ fn the_sweep_is_deterministic_whatever_the_threads() {
 /// docs/DIAGNOSIS.md. A failure lists each flag with its case, time, fault and score.
 #[test]
 fn healthy_machines_raise_no_flag_in_half_an_hour() {
-    use bearingd::evaluate::false_alarms::{stream_run, summarize_false_alarms, FalseAlarmPlan};
+    use bearingd_lab::evaluate::false_alarms::{
+        stream_run, summarize_false_alarms, FalseAlarmPlan,
+    };
     let bench = Bench::embedded().expect("the embedded default config validates");
     // A seed of its own: these runs are not the start of the documented measurement's (seed 1).
     let plan = FalseAlarmPlan::new(1.0 / 6.0, 30);
     let runs = plan.runs();
-    let results = bearingd::evaluate::in_order(
+    let results = bearingd_lab::evaluate::in_order(
         &runs,
         2,
         || (),

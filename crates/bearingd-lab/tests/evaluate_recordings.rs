@@ -1,4 +1,4 @@
-//! `bearingd evaluate --recordings` (issue 30, item 5): the developer set's recordings through
+//! `bearingd-lab evaluate --recordings` (issue 30, item 5): the developer set's recordings through
 //! `analyze` and through the daemon (`import` + `replay`, in-process), with the manifests'
 //! truth. What must hold now: every record gets both paths' answers (or is said to be too
 //! short for the daemon), the daemon path is what `bearingd import` + `bearingd replay` give,
@@ -6,20 +6,48 @@
 //! themselves (confident-wrong, disagreements) are printed, not asserted: the decision is
 //! still being changed (docs/DIAGNOSIS.md "Recordings").
 
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bearingd::analysis::agreement::Agreement;
-use bearingd::evaluate::outcome::Predicted;
-use bearingd::evaluate::recordings::{
-    evaluate_recordings, plan, render_recordings, tally, DaemonOutcome, Entry, Manifest,
-    RecordingsAgreement, RecordingsOptions, RecordingsReport, Truth,
-};
-use bearingd::evaluate::run::CaseSignal;
-use bearingd::evaluate::{NoiseLevel, Sweep};
 use bearingd::learned::LearnedModel;
 use bearingd::messages::FaultKind;
 use bearingd::twin::{SimulatedFault, Simulator};
+use bearingd_lab::evaluate::outcome::Predicted;
+use bearingd_lab::evaluate::recordings::{
+    evaluate_recordings, plan, render_recordings, tally, DaemonOutcome, Entry, Manifest,
+    RecordingsAgreement, RecordingsOptions, RecordingsReport, Truth,
+};
+use bearingd_lab::evaluate::run::CaseSignal;
+use bearingd_lab::evaluate::{NoiseLevel, Sweep};
 use bearingd_testdata::{mcap_files, scratch_dir, shared_data_dir};
 use std::collections::BTreeMap;
 use std::process::Command;
+
+/// The service binary `bearingd`, which the workspace builds beside `bearingd-lab` (a test of
+/// this crate cannot ask cargo for another package's binary).
+fn service_binary() -> std::path::PathBuf {
+    let lab = std::path::Path::new(env!("CARGO_BIN_EXE_bearingd-lab"));
+    let service = lab.with_file_name("bearingd");
+    assert!(
+        service.is_file(),
+        "{} is missing: build the service first (`cargo build --release -p bearingd`)",
+        service.display()
+    );
+    service
+}
+
+/// `bearingd replay --quiet --json FILES`: its JSON report.
+fn replay_json(files: &[std::path::PathBuf], out: &std::path::Path) -> serde_json::Value {
+    let result = Command::new(service_binary())
+        .args(["replay", "--quiet", "--json", "--out"])
+        .arg(out)
+        .args(files)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert!(result.status.success(), "{stderr}");
+    serde_json::from_slice(&result.stdout).unwrap()
+}
 
 fn run(manifests: &[Manifest], out: &std::path::Path) -> Vec<Entry> {
     run_agreeing(manifests, out, None)
@@ -182,15 +210,14 @@ fn the_daemon_path_flags_what_import_and_replay_flag() {
     );
 
     let imported = out.join("imported");
-    let status = Command::new(env!("CARGO_BIN_EXE_bearingd"))
+    let status = Command::new(service_binary())
         .args(["import", record.file.to_str().unwrap(), "--out"])
         .arg(&imported)
         .args(["--channel", record.channel.as_deref().unwrap()])
         .output()
         .unwrap();
     assert!(status.status.success(), "{status:?}");
-    let (replayed, _) =
-        super::replay::replay_json(&mcap_files(&imported), &out.join("replayed"), &[]);
+    let replayed = replay_json(&mcap_files(&imported), &out.join("replayed"));
     let by_cli: Vec<(String, String, u64)> = replayed["flags"]
         .as_array()
         .unwrap()
@@ -260,7 +287,7 @@ fn a_two_and_a_half_second_record_that_analyze_names_is_flagged_by_the_daemon() 
         };
         assert_eq!(
             record.predicted,
-            bearingd::evaluate::outcome::Predicted::Fault(fault),
+            bearingd_lab::evaluate::outcome::Predicted::Fault(fault),
             "{label}: analyze on 2.5 s"
         );
         let DaemonOutcome::Judged { monitor, flags, .. } = &e.daemon else {
@@ -282,15 +309,15 @@ fn a_two_and_a_half_second_record_that_analyze_names_is_flagged_by_the_daemon() 
 #[test]
 fn missing_manifests_and_files_are_said_and_fail_under_strict() {
     let dir = scratch_dir("evaluate-recordings-bad");
-    let bearingd = |args: &[&str]| {
-        Command::new(env!("CARGO_BIN_EXE_bearingd"))
+    let lab = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_bearingd-lab"))
             .args(args)
             .output()
             .unwrap()
     };
     let out = dir.join("out");
     let missing = dir.join("nothing.csv");
-    let result = bearingd(&[
+    let result = lab(&[
         "evaluate",
         "--recordings",
         missing.to_str().unwrap(),
@@ -313,14 +340,14 @@ fn missing_manifests_and_files_are_said_and_fail_under_strict() {
         "--out",
         out.to_str().unwrap(),
     ];
-    let result = bearingd(&args);
+    let result = lab(&args);
     let stdout = String::from_utf8_lossy(&result.stdout);
     assert_eq!(result.status.code(), Some(0), "{stdout}");
     assert!(
         stdout.contains("gone.mat: ") && stdout.contains("file not found"),
         "{stdout}"
     );
-    let strict = bearingd(&[&args[..], &["--strict"]].concat());
+    let strict = lab(&[&args[..], &["--strict"]].concat());
     let stderr = String::from_utf8_lossy(&strict.stderr);
     assert_eq!(strict.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("1 failed record(s)"), "{stderr}");

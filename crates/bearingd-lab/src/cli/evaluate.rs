@@ -1,9 +1,8 @@
-//! `bearingd evaluate`: sweep the simulator through the real pipeline and report how well the
+//! `bearingd-lab evaluate`: sweep the simulator through the real pipeline and report how well the
 //! detector does; with `--recordings`, real recordings of a manifest through `analyze` and
 //! through the daemon's replay; with `--false-alarm-hours`, hours of healthy signal through the
 //! daemon's channel monitor (see `crate::evaluate` and docs/DIAGNOSIS.md).
 
-use super::CliError;
 use crate::evaluate::false_alarms::{
     render_false_alarms, stream_run, summarize_false_alarms, FalseAlarmPlan, FalseAlarmSummary,
     RunResult,
@@ -17,6 +16,7 @@ use crate::evaluate::{
     Path as JudgedPath, Summary, Sweep,
 };
 use crate::twin::Nuisance;
+use bearingd::cli::CliError;
 use clap::Args;
 use serde::Serialize;
 use std::fmt::Write as _;

@@ -15,11 +15,11 @@ use crate::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisSettings, Diagnosis};
 use crate::config::{Config, SensorConfig, SimConfig, Speed, Transport};
-use crate::learned::ModelError;
 use crate::messages::FaultKind;
 use crate::messages::FlagLevel;
 use crate::pipeline::{load_learned, monitor_settings};
 use crate::twin::{Nuisance, SimulatedFault, SimulationParams, Simulator};
+use bearingd::learned::ModelError;
 use serde::Serialize;
 use std::sync::Arc;
 
