@@ -26,7 +26,7 @@ use crate::messages::FaultKind;
 use serde::Serialize;
 
 /// What the analysis concludes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Verdict {
     None,

@@ -14,9 +14,10 @@ use serde::Serialize;
 pub enum Predicted {
     None,
     Fault(FaultKind),
-    /// The record path declined to pick between named hypotheses (a verdict that is neither
-    /// `none` nor one fault).
-    Ambiguous,
+    /// Two faults named, not told apart: the record path's pair verdict
+    /// ([`Verdict::PAIRS`]: `ball_or_cage`, `ball_or_inner`), or the monitor raising the flags
+    /// of exactly such a pair. It carries the pair, so both paths saying the same pair agree.
+    Ambiguous(Verdict),
     /// The monitor raised the flags of more than one fault kind.
     Several,
 }
@@ -26,26 +27,26 @@ impl Predicted {
         match self {
             Predicted::None => "none",
             Predicted::Fault(kind) => kind.name(),
-            Predicted::Ambiguous => "ambiguous",
+            Predicted::Ambiguous(pair) => pair.name(),
             Predicted::Several => "several",
         }
     }
 
     /// The columns of a confusion matrix, in order.
-    pub const COLUMNS: [Predicted; 7] = [
+    pub const COLUMNS: [Predicted; 8] = [
         Predicted::None,
         Predicted::Fault(FaultKind::OuterRace),
         Predicted::Fault(FaultKind::InnerRace),
         Predicted::Fault(FaultKind::Ball),
         Predicted::Fault(FaultKind::Cage),
-        Predicted::Ambiguous,
+        Predicted::Ambiguous(Verdict::BallOrCage),
+        Predicted::Ambiguous(Verdict::BallOrInner),
         Predicted::Several,
     ];
 
     /// What the flags say, from the highest level each fault's flag reached (outer, inner,
     /// ball, cage): the one fault whose flag rose, none, the two of a verdict that cannot tell
-    /// them apart (a rolling element or the cage, or the inner race: ambiguous, as that
-    /// verdict), or several.
+    /// them apart (a rolling element or the cage, or the inner race: that pair), or several.
     pub fn of_flags(highest: [FlagLevel; 4]) -> Self {
         let raised: Vec<FaultKind> = FaultKind::ALL
             .into_iter()
@@ -56,19 +57,21 @@ impl Predicted {
         match raised.as_slice() {
             [] => Predicted::None,
             [kind] => Predicted::Fault(*kind),
-            both if Verdict::PAIRS.iter().any(|pair| pair.faults() == both) => Predicted::Ambiguous,
-            _ => Predicted::Several,
+            both => Verdict::PAIRS
+                .into_iter()
+                .find(|pair| pair.faults() == both)
+                .map_or(Predicted::Several, Predicted::Ambiguous),
         }
     }
 
     /// What a verdict says. Written against the verdict's public meaning (`fault()` names one
     /// fault or none), so that a verdict added later for "both named, not separable" counts as
-    /// ambiguous without a change here.
+    /// that pair without a change here.
     pub fn of_verdict(verdict: Verdict) -> Self {
         match verdict.fault() {
             Some(kind) => Predicted::Fault(kind),
             None if verdict == Verdict::None => Predicted::None,
-            None => Predicted::Ambiguous,
+            None => Predicted::Ambiguous(verdict),
         }
     }
 }
@@ -175,11 +178,11 @@ mod tests {
         // Outer, inner, ball, cage.
         assert_eq!(
             Predicted::of_flags([ok, alarm, alarm, ok]),
-            Predicted::Ambiguous
+            Predicted::Ambiguous(Verdict::BallOrInner)
         );
         assert_eq!(
             Predicted::of_flags([ok, ok, alarm, alarm]),
-            Predicted::Ambiguous
+            Predicted::Ambiguous(Verdict::BallOrCage)
         );
         assert_eq!(
             Predicted::of_flags([alarm, alarm, ok, ok]),
@@ -187,7 +190,11 @@ mod tests {
         );
         assert_eq!(
             Predicted::of_verdict(Verdict::BallOrInner),
-            Predicted::Ambiguous
+            Predicted::Ambiguous(Verdict::BallOrInner)
+        );
+        assert_eq!(
+            Predicted::Ambiguous(Verdict::BallOrInner).name(),
+            "ball_or_inner"
         );
     }
 }

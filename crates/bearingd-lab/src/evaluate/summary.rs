@@ -102,7 +102,10 @@ pub fn is_confident_wrong(truth: Option<FaultKind>, predicted: Predicted) -> boo
         Predicted::Fault(kind) => truth != Some(kind),
         // Several flags on a faulty record: at least one is wrong; on a healthy one, all are.
         Predicted::Several => true,
-        Predicted::None | Predicted::Ambiguous => false,
+        // A pair is wrong when the true fault is not one of its two (on a healthy record both
+        // of its flags are false alarms); naming the true fault among two is not wrong.
+        Predicted::Ambiguous(pair) => truth.is_none_or(|kind| !pair.faults().contains(&kind)),
+        Predicted::None => false,
     }
 }
 
@@ -283,7 +286,7 @@ pub fn render_confusion(
         .filter(|c| {
             let possible = !matches!(
                 (path, c),
-                (Path::Record, Predicted::Several) | (Path::Monitor, Predicted::Ambiguous)
+                (Path::Record, Predicted::Several) | (Path::Monitor, Predicted::Ambiguous(_))
             );
             possible || occurred(c.name())
         })
@@ -357,4 +360,27 @@ pub fn render_csv(results: &[CaseResult]) -> String {
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::analysis::Verdict;
+
+    #[test]
+    fn a_pair_is_wrong_only_when_the_truth_is_not_one_of_its_two() {
+        let ball_or_inner = Predicted::Ambiguous(Verdict::BallOrInner);
+        assert!(!is_confident_wrong(Some(FaultKind::Ball), ball_or_inner));
+        assert!(!is_confident_wrong(
+            Some(FaultKind::InnerRace),
+            ball_or_inner
+        ));
+        assert!(is_confident_wrong(
+            Some(FaultKind::OuterRace),
+            ball_or_inner
+        ));
+        // On a healthy record its two flags are false alarms.
+        assert!(is_confident_wrong(None, ball_or_inner));
+        assert!(!is_confident_wrong(None, Predicted::None));
+    }
 }

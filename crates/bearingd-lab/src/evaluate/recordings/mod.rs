@@ -230,10 +230,11 @@ impl Entry {
     }
 }
 
-/// Whether two answers agree: the daemon flagged exactly the verdict's fault, or nothing for a
-/// `none` verdict. An ambiguous verdict or several flags never agree.
+/// Whether two answers agree: the daemon flagged exactly the verdict's fault, exactly the two
+/// flags of a pair verdict (`ball_or_inner`: inner race and ball), or nothing for a `none`
+/// verdict. Several flags never agree.
 pub fn agrees(record: Predicted, daemon: Predicted) -> bool {
-    record == daemon && matches!(record, Predicted::None | Predicted::Fault(_))
+    record == daemon && record != Predicted::Several
 }
 
 /// Whether the paths agree on an entry; `None` when one has no answer.

@@ -174,7 +174,7 @@ fn count(path: Path, entries: &[Entry]) -> PathTally {
         };
         t.right += u64::from(right);
         t.missed += u64::from(truth.is_some() && predicted == Predicted::None);
-        t.ambiguous += u64::from(predicted == Predicted::Ambiguous);
+        t.ambiguous += u64::from(matches!(predicted, Predicted::Ambiguous(_)));
         if is_confident_wrong(truth, predicted) {
             t.confident_wrong += 1;
             t.false_alarms += u64::from(truth.is_none());
@@ -521,14 +521,22 @@ mod tests {
     }
 
     #[test]
-    fn only_one_named_fault_or_none_on_both_sides_agrees() {
+    fn the_same_fault_pair_or_none_on_both_sides_agrees() {
+        use crate::analysis::Verdict;
         use Predicted as P;
         let inner = P::Fault(FaultKind::InnerRace);
+        let (ball_or_inner, ball_or_cage) = (
+            P::Ambiguous(Verdict::BallOrInner),
+            P::Ambiguous(Verdict::BallOrCage),
+        );
         assert!(agrees(P::None, P::None));
         assert!(agrees(inner, inner));
         assert!(!agrees(inner, P::None));
         assert!(!agrees(P::None, inner));
-        assert!(!agrees(P::Ambiguous, P::Ambiguous));
+        assert!(agrees(ball_or_inner, ball_or_inner));
+        assert!(!agrees(ball_or_inner, ball_or_cage));
+        assert!(!agrees(ball_or_inner, inner));
         assert!(!agrees(inner, P::Several));
+        assert!(!agrees(P::Several, P::Several));
     }
 }
