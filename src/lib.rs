@@ -8,7 +8,8 @@
 //! - [`cli`]: the `bearingd` command line; the only place that prints, exits, or turns typed errors
 //!   into messages for people. Lab commands are handed to the `bearingd-lab` binary
 //!   (crates/bearingd-lab, which uses this library and is never linked into the service): training,
-//!   simulation, the physics twin and the detector evaluation (`bearingd evaluate`).
+//!   simulation, the physics twin, the detector evaluation (`bearingd evaluate`), a bearing's
+//!   life (`bearingd trend`) and every picture (`bearingd analyze --plot`).
 //! - [`daemon`]: wiring only: `run` and `replay` lock the data dir, start sources, the pipeline
 //!   and sinks, and stop them; what happens is reported as typed events, never printed.
 //! - [`sources`]: SocketCAN, iceoryx2, the simulated sensor and MCAP replay → sample blocks in
@@ -16,10 +17,8 @@
 //! - [`sinks`]: where the pipeline's messages go: the MCAP log writer, iceoryx2 alerts, the
 //!   systemd notify protocol, the fleet bridge (MQTT Sparkplug B with store-and-forward).
 //! - [`offline`]: one recording analysed end to end (`bearingd analyze` as a library call).
-//! - [`report`]: what `analyze` and `trend` show: JSON, text and the figure, from one report.
-//! - [`life`]: a bearing's life of snapshots, in time order, through the daemon's health tracker
-//!   with the HW residual, the fault score and the RMS trend (`bearingd trend`).
-//! - [`plot`]: pictures of spectra and kurtograms (PNG and SVG), drawn without system fonts.
+//! - [`report`]: what `analyze` shows: JSON and text from one report (the figure of the same
+//!   report is drawn by the lab, `bearingd analyze --plot`).
 //! - [`pipeline`]: the per-channel pipeline shared by `run` and `replay`, its outputs, the twin's
 //!   re-fit requests (served per channel in turn), the band-selection worker and the
 //!   [`Sink`](pipeline::Sink) trait, the seam to the sinks.
@@ -66,13 +65,11 @@ pub mod daemon;
 pub mod fsafe;
 pub mod iox;
 pub mod learned;
-pub mod life;
 pub use bearing_signal::machine_fault;
 pub mod mcap_log;
 pub mod messages;
 pub mod offline;
 pub mod pipeline;
-pub mod plot;
 pub use bearing_signal::random;
 pub mod recording;
 pub mod report;

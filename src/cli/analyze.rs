@@ -1,11 +1,14 @@
-//! `bearingd analyze FILE...`: diagnose recordings and show the evidence.
+//! `bearingd analyze FILE...`: diagnose recordings and show the evidence. The text, JSON and
+//! table are the service's; `--plot` is drawn by the lab (`bearingd-lab analyze`, which runs
+//! this same command through [`run_with`] and adds the figure of each record), so that the
+//! service links no drawing code.
 
 use super::{CliError, RecordingArgs};
 use crate::analysis::iso::{Foundation, MachineGroup, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisSettings, BandSelection};
-use crate::offline::{analyze, AnalyzeRequest};
-use crate::report::{analysis_figure, render_text, AnalyzeReport};
+use crate::offline::{analyze, AnalyzeOutcome, AnalyzeRequest};
+use crate::report::{render_text, AnalyzeReport};
 use crate::twin::hw::StateFilter;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
@@ -42,9 +45,9 @@ pub struct AnalyzeArgs {
     #[arg(long, value_enum, default_value = "text")]
     format: OutputFormat,
     /// Draw the envelope spectrum and the kurtogram to this file (.png or .svg); with several
-    /// records, the record's file name is added before the extension.
+    /// records, the record's file name is added before the extension. Runs in bearingd-lab.
     #[arg(long)]
-    plot: Option<PathBuf>,
+    pub plot: Option<PathBuf>,
     /// Take the analysis settings from this configuration file's [analysis] section, and its
     /// twin.learned_model unless --learned is given: the daemon's decision, offline.
     #[arg(long)]
@@ -124,7 +127,21 @@ fn severity_from(args: &AnalyzeArgs) -> SeveritySettings {
     }
 }
 
+/// What a caller adds for each analysed record (the lab: its figure), with the number of
+/// records asked for.
+pub type OnRecord<'a> = dyn FnMut(&AnalyzeOutcome, usize) -> Result<(), CliError> + 'a;
+
+/// `bearingd analyze`: with `--plot`, handed to `bearingd-lab` (this process is replaced).
 pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
+    if args.plot.is_some() {
+        return Err(super::lab::exec_lab("analyze --plot"));
+    }
+    run_with(args, &mut |_, _| Ok(()))
+}
+
+/// The analysis of every record asked for, printed as `--format` says; `on_record` sees each
+/// record's outcome before it is printed.
+pub fn run_with(args: &AnalyzeArgs, on_record: &mut OnRecord) -> Result<(), CliError> {
     if args.hw {
         return super::hw_table::run(&args.files, &args.recording, args.hw_states.into());
     }
@@ -175,18 +192,7 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
             }
             Err(error) => return Err(CliError::input(error)),
         };
-        if let Some(plot) = &args.plot {
-            let path = if files.len() > 1 {
-                per_record_path(plot, &outcome.report.file)
-            } else {
-                plot.clone()
-            };
-            crate::plot::save(
-                &analysis_figure(&outcome.report, &outcome.analysis, outcome.twin.as_ref()),
-                &path,
-            )
-            .map_err(CliError::input)?;
-        }
+        on_record(&outcome, files.len())?;
         match args.format {
             OutputFormat::Text => print!("{}", render_text(&outcome.report)),
             OutputFormat::Table => println!("{}", table_row(&outcome.report)),
@@ -232,23 +238,6 @@ fn table_row(r: &AnalyzeReport) -> String {
         r.diagnosis,
         r.confidence
     )
-}
-
-/// `out.png` + `dir/105.mat` → `out-105.png`.
-fn per_record_path(plot: &Path, record: &str) -> PathBuf {
-    let stem = plot
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let ext = plot
-        .extension()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let record = Path::new(record)
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    plot.with_file_name(format!("{stem}-{record}.{ext}"))
 }
 
 fn settings_from(

@@ -1,6 +1,7 @@
-//! The lab commands seen from the service binary. Training, simulation, the physics twin and the evaluation live
-//! in a second binary, `bearingd-lab` (crates/bearingd-lab; the pictures follow),
-//! so that the service a box runs does not link candle or the ODE solver. A user still types
+//! The lab commands seen from the service binary. Training, simulation, the physics twin, the
+//! evaluation, a bearing's life (`trend`) and every picture (`analyze --plot`) live in a second
+//! binary, `bearingd-lab` (crates/bearingd-lab), so that the service a box runs does not link
+//! candle, the ODE solver or a rasterizer. A user still types
 //! `bearingd train ...`: the service replaces itself with `bearingd-lab` and the same arguments
 //! (`exec`, so the exit code and signals are the lab's own).
 
@@ -14,9 +15,16 @@ use std::process::Command;
 /// The lab binary's name, looked up beside the running `bearingd`, then on PATH.
 pub const LAB_BINARY: &str = "bearingd-lab";
 
-/// The commands `bearingd-lab` runs. (Issue 31 moves `trend` and `analyze --plot` there next,
-/// with the plotting code; until then the service runs them itself.)
-pub const LAB_COMMANDS: &[&str] = &["simulate", "dataset", "train", "calibrate", "evaluate"];
+/// The commands `bearingd-lab` runs. (`analyze` runs there too when it is asked for `--plot`:
+/// [`super::analyze::run`] hands it over once its arguments are parsed.)
+pub const LAB_COMMANDS: &[&str] = &[
+    "simulate",
+    "dataset",
+    "train",
+    "calibrate",
+    "evaluate",
+    "trend",
+];
 
 /// The lab command `args` (without the program name) asks for, if it asks for one.
 pub fn lab_command<S: AsRef<str>>(args: &[S]) -> Option<&'static str> {
@@ -71,6 +79,10 @@ mod tests {
         assert_eq!(
             lab_command(&["evaluate", "--recordings", "m.csv"]),
             Some("evaluate")
+        );
+        assert_eq!(
+            lab_command(&["trend", "life/", "--plot", "x.svg"]),
+            Some("trend")
         );
         assert_eq!(lab_command(&["analyze", "a.mat", "--plot", "x.png"]), None);
         assert_eq!(lab_command(&["run", "--config", "train"]), None);

@@ -14,9 +14,9 @@ mod hw_table;
 pub mod import;
 mod ingest;
 pub mod lab;
+mod progress;
 mod replay;
 mod run;
-mod trend;
 
 use clap::{Args, Parser, Subcommand};
 use std::process::ExitCode;
@@ -103,8 +103,8 @@ enum Command {
     Evaluate(lab::LabArgs),
     /// Follow a bearing's life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs):
     /// health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its
-    /// time to the failure limit; text, JSON or a table, and a plot.
-    Trend(trend::TrendArgs),
+    /// time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab.
+    Trend(lab::LabArgs),
     /// Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV.
     /// Runs in bearingd-lab.
     Simulate(lab::LabArgs),
@@ -171,7 +171,7 @@ pub fn main() -> ExitCode {
         Command::Simulate(_) => Err(lab::exec_lab("simulate")),
         Command::Dataset(_) => Err(lab::exec_lab("dataset")),
         Command::Train(_) => Err(lab::exec_lab("train")),
-        Command::Trend(args) => trend::run(&args),
+        Command::Trend(_) => Err(lab::exec_lab("trend")),
         Command::Evaluate(_) => Err(lab::exec_lab("evaluate")),
         Command::Calibrate(_) => Err(lab::exec_lab("calibrate")),
         Command::Validate { file } => config_cmd::validate(&file),

@@ -5,6 +5,7 @@
 //! override changes, the order the files are read in, run boundaries, gaps and what could not
 //! be read.
 
+use super::progress::ProgressLine;
 use super::run::{event_line, print_events};
 use super::CliError;
 use crate::config::{self, Config};
@@ -95,7 +96,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     // Created 0750, and refused if others can write in it (they could plant links there).
     crate::fsafe::prepare_private_dir(&args.out).map_err(CliError::input)?;
     let _lock = DirLock::acquire(&args.out).map_err(CliError::input)?;
-    let bar = progress_bar(args, plan.bytes());
+    let bar = progress_line(args);
     let options = ReplayOptions {
         speed: args.speed,
         progress_every: match (&bar, args.quiet) {
@@ -105,7 +106,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
         },
     };
     let events = match &bar {
-        Some(bar) => bar_events(bar.clone()),
+        Some(bar) => line_events(Arc::clone(bar)),
         None => print_events(),
     };
     let mut open_sinks = |run: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {
@@ -119,7 +120,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     };
     let replayed = replay(&plan, &config.clone(), &options, &mut open_sinks, &events);
     if let Some(bar) = &bar {
-        bar.finish_and_clear();
+        bar.clear();
     }
     let summary = replayed.map_err(CliError::failure)?;
     if args.json {
@@ -206,35 +207,29 @@ fn resolve_settings(
     }
 }
 
-/// A progress bar over the bytes of the files, when stderr is a terminal and not `--quiet`.
-fn progress_bar(args: &ReplayArgs, bytes: u64) -> Option<indicatif::ProgressBar> {
+/// A progress line over the bytes of the files, when stderr is a terminal and not `--quiet`.
+fn progress_line(args: &ReplayArgs) -> Option<Arc<ProgressLine>> {
     if args.quiet || !std::io::stderr().is_terminal() {
         return None;
     }
-    let bar = indicatif::ProgressBar::new(bytes);
-    let style = indicatif::ProgressStyle::with_template(
-        "replay {bar:20} {bytes}/{total_bytes} ({eta}) {msg}",
-    )
-    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-    bar.set_style(style);
-    Some(bar)
+    Some(Arc::new(ProgressLine::default()))
 }
 
-/// Events to stderr above the bar; progress moves the bar.
-fn bar_events(bar: indicatif::ProgressBar) -> Events {
+/// Events to stderr above the progress line; progress redraws the line.
+fn line_events(line: Arc<ProgressLine>) -> Events {
     Arc::new(move |event| match event {
         DaemonEvent::ReplayProgress {
             sample_seconds,
             bytes_read,
+            bytes_total,
             flag_changes,
             ..
-        } => {
-            bar.set_position(bytes_read);
-            bar.set_message(format!(
-                "{sample_seconds:.0} s, {flag_changes} flag changes"
-            ));
-        }
-        other => bar.suspend(|| eprintln!("{}", event_line(&other))),
+        } => line.show(
+            bytes_read,
+            bytes_total,
+            &format!("{sample_seconds:.0} s, {flag_changes} flag changes"),
+        ),
+        other => line.print_above(&event_line(&other)),
     })
 }
 

@@ -1,16 +1,10 @@
 //! What `analyze` tells its user about a record: a JSON document for programs, a text summary
-//! for people, and a figure for the eyes. One [`AnalyzeReport`] feeds all three so that they
-//! always say the same thing.
+//! for people, and a figure for the eyes (drawn by the lab crate, `bearingd-lab`, from the same
+//! report). One [`AnalyzeReport`] feeds all three so that they always say the same thing.
 
-mod figure;
-mod life;
 pub mod plain;
 mod text;
 
-pub use figure::analysis_figure;
-pub use life::{
-    duration_text, life_figure, render_life_text, LifeReport, LifeSettingsReport, SkippedFile,
-};
 pub use text::render_text;
 
 use crate::analysis::defect_size::{DefectSize, NotMeasured};

@@ -1,5 +1,5 @@
-//! The `bearingd` binary as a user meets it: outputs, pictures, and one-line errors with exit
-//! code 2 for every kind of bad input.
+//! The `bearingd` binary as a user meets it: outputs and one-line errors with exit
+//! code 2 for every kind of bad input (the pictures, drawn by the lab: crates/bearingd-lab/tests).
 
 use bearingd_testdata::{scratch_dir, shared_data_dir};
 use std::path::Path;
@@ -112,30 +112,6 @@ fn analyze_opens_with_the_plain_verdict_and_says_why_a_fault_is_not_named() {
             assert_eq!(h["why_not"].is_string(), !is_named, "{file}: {h}");
         }
     }
-}
-
-#[test]
-fn plots_are_written_as_png_and_svg() {
-    let dir = scratch_dir("cli-plot");
-    let png = dir.join("demo.png");
-    let svg = dir.join("demo.svg");
-    for path in [&png, &svg] {
-        let out = bearingd(&["analyze", "--demo", "--plot", path.to_str().unwrap()]);
-        assert!(out.status.success(), "{}", stderr(&out));
-    }
-    let bytes = std::fs::read(&png).unwrap();
-    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
-    let text = std::fs::read_to_string(&svg).unwrap();
-    assert!(text.contains("<svg") && text.contains("BPFO") && text.contains("GK index"));
-    expect_input_error(
-        &[
-            "analyze",
-            "--demo",
-            "--plot",
-            dir.join("demo.gif").to_str().unwrap(),
-        ],
-        &["demo.gif", ".png"],
-    );
 }
 
 #[test]

@@ -18,9 +18,16 @@
 //! - [`learned`]: training the learned diagnosis (candle): the trainable network and the
 //!   training loop on a data set of [`twin::dataset`]; the service's `bearingd::learned` runs
 //!   what it writes.
+//! - [`report`]: what the lab draws and tells of the service's results: `analyze`'s figure of a
+//!   record (`bearingd analyze --plot`) and a bearing's life (`bearingd trend`) as text, JSON
+//!   and a figure.
+//! - [`life`]: a bearing's life of snapshots, in time order, through the daemon's health tracker
+//!   with the HW residual, the fault score and the RMS trend (`bearingd trend`).
 //! - [`twin`]: the physics twin (6-DOF contact model, ODE integration, its calibration by a
 //!   parallel differential evolution), the labelled synthetic data sets and the defect-size
 //!   check on the physics twin; the service's signal-model twin re-exported beside them.
+//! - [`plot`]: pictures of spectra and heatmaps (PNG and SVG), drawn without system fonts: the
+//!   service links no rasterizer.
 //!
 //! The service's rooms this crate's modules use by their usual paths (`crate::analysis`, ...),
 //! re-exported below: all of them sit under every room above.
@@ -28,9 +35,12 @@
 pub mod cli;
 pub mod evaluate;
 pub mod learned;
+pub mod life;
+pub mod plot;
+pub mod report;
 pub mod twin;
 
 pub use bearingd::{
-    analysis, bearing, clock, config, daemon, machine_fault, messages, offline, pipeline, plot,
-    random, recording, report, sinks, sources,
+    analysis, bearing, clock, config, daemon, machine_fault, messages, offline, pipeline, random,
+    recording, sinks, sources,
 };

@@ -23,17 +23,9 @@ use bearingd_testdata::{mcap_files, scratch_dir, shared_data_dir};
 use std::collections::BTreeMap;
 use std::process::Command;
 
-/// The service binary `bearingd`, which the workspace builds beside `bearingd-lab` (a test of
-/// this crate cannot ask cargo for another package's binary).
+/// The service binary `bearingd`, which the workspace builds beside `bearingd-lab`.
 fn service_binary() -> std::path::PathBuf {
-    let lab = std::path::Path::new(env!("CARGO_BIN_EXE_bearingd-lab"));
-    let service = lab.with_file_name("bearingd");
-    assert!(
-        service.is_file(),
-        "{} is missing: build the service first (`cargo build --release -p bearingd`)",
-        service.display()
-    );
-    service
+    bearingd_testdata::binary_beside(env!("CARGO_BIN_EXE_bearingd-lab"), "bearingd")
 }
 
 /// `bearingd replay --quiet --json FILES`: its JSON report.

@@ -282,6 +282,19 @@ pub fn noise(len: usize, mut seed: u64) -> Vec<u8> {
         .collect()
 }
 
+/// The binary `name` of the workspace beside `exe` (a test's own `env!("CARGO_BIN_EXE_...")`):
+/// a test of one package cannot ask cargo for another package's binary. A missing one fails the
+/// test, naming the command that builds it (each binary is its package's name).
+pub fn binary_beside(exe: &str, name: &str) -> PathBuf {
+    let path = Path::new(exe).with_file_name(name);
+    assert!(
+        path.is_file(),
+        "{} is missing: build it first (`cargo build --release -p {name}`)",
+        path.display()
+    );
+    path
+}
+
 /// Runs `program` (a binary of the workspace, e.g. `env!("CARGO_BIN_EXE_bearingd")`) with
 /// `args` and returns what it did. A lab command (`simulate`, `train`, `analyze --plot`, ...)
 /// that `bearingd` could not hand over because `bearingd-lab` is not built beside it fails the

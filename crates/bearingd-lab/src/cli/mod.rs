@@ -2,11 +2,13 @@
 //! (the service binary hands them over unparsed). Errors, exit codes (0 success, 2 bad input,
 //! 1 anything else) and the shared arguments are the service's own ([`bearingd::cli`]).
 
+mod analyze;
 mod calibrate;
 mod dataset;
 mod evaluate;
 mod simulate;
 mod train;
+mod trend;
 mod twin_args;
 
 use bearingd::cli::{end_quietly_on_a_closed_pipe, exit_code, CliError};
@@ -41,6 +43,13 @@ enum Command {
     /// through the real pipeline: detection probability, false alarms, confusion matrix, plot;
     /// or real recordings of a manifest through `analyze` and through the daemon.
     Evaluate(evaluate::EvaluateArgs),
+    /// Follow a bearing's life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs):
+    /// health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its
+    /// time to the failure limit; text, JSON or a table, and a plot.
+    Trend(trend::TrendArgs),
+    /// Diagnose a recording as `bearingd analyze` does, and draw the envelope spectrum and the
+    /// kurtogram with --plot (`bearingd analyze --plot` runs this).
+    Analyze(bearingd::cli::analyze::AnalyzeArgs),
 }
 
 /// Parses the command line, runs the command, prints errors, returns the exit code. Every lab
@@ -54,6 +63,8 @@ pub fn main() -> ExitCode {
         Command::Train(args) => train::run(&args),
         Command::Calibrate(args) => calibrate::run(&args),
         Command::Evaluate(args) => evaluate::run(&args),
+        Command::Trend(args) => trend::run(&args),
+        Command::Analyze(args) => analyze::run(&args),
     };
     exit_code("bearingd-lab", result)
 }

@@ -49,10 +49,10 @@ use crate::pipeline::{Sink, SinkError};
 use crate::recording::{
     detect_format, list_channels, read_recording, ReadOptions, RecordingFormat,
 };
-use crate::report::SpeedSource;
 use crate::sinks::mcap::raw_log::{import_recording, Import, LogSignal};
 use crate::sources::replay::plan::{LoggedSettings, ReplayPlan};
 use bearingd::learned::{LearnedModel, ModelError};
+use bearingd::report::SpeedSource;
 use serde::Serialize;
 use std::io::Read;
 use std::path::{Path, PathBuf};

@@ -1,10 +1,20 @@
-//! The physics twin through the command line (issue 14): `simulate --model physics` writes
+//! The physics twin through the lab's command line (issue 14): `simulate --model physics` writes
 //! records `analyze` reads and diagnoses; `calibrate` fits a real CWRU record, prints the
 //! parameters and the fit error, draws the spectra and saves parameters that `simulate
 //! --calibrated` uses.
 
-use crate::cli::{bearingd, stderr};
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bearingd_testdata::{scratch_dir, shared_data_dir};
+use std::process::Output;
+
+fn lab(args: &[&str]) -> Output {
+    bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd-lab"), args)
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
 
 /// Simulates `fault` with the physics twin into `path`, analyses it, returns the diagnosis.
 fn simulate_and_diagnose(extra: &[&str], path: &str) -> String {
@@ -22,9 +32,9 @@ fn simulate_and_diagnose(extra: &[&str], path: &str) -> String {
         path,
     ];
     args.extend_from_slice(extra);
-    let made = bearingd(&args);
+    let made = lab(&args);
     assert!(made.status.success(), "{args:?}: {}", stderr(&made));
-    let out = bearingd(&[
+    let out = lab(&[
         "analyze",
         path,
         "--rpm",
@@ -74,7 +84,7 @@ fn calibrate_fits_a_cwru_record_and_its_parameters_simulate() {
     let plot = dir.join("calibration.png");
     let saved = dir.join("cwru130.json");
     // A small budget: CI checks the command, docs/PHYSICS.md has the full calibration.
-    let out = bearingd(&[
+    let out = lab(&[
         "calibrate",
         record.to_str().unwrap(),
         "--population",
@@ -127,7 +137,7 @@ fn calibrate_refuses_bad_input_in_one_line() {
             "--band 4000-2000",
         ),
     ] {
-        let out = bearingd(&args);
+        let out = lab(&args);
         let err = stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
@@ -135,7 +145,7 @@ fn calibrate_refuses_bad_input_in_one_line() {
     }
     let bad = dir.join("bad.json");
     std::fs::write(&bad, "{not json").unwrap();
-    let out = bearingd(&[
+    let out = lab(&[
         "simulate",
         "--model",
         "physics",

@@ -1,12 +1,12 @@
 //! The picture of an analysis: the envelope spectrum with the fault frequencies and their
 //! harmonics marked (tolerance shaded), and the kurtogram with the band that was used.
 
-use super::AnalyzeReport;
 use crate::analysis::iso::VelocitySeverity;
 use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::messages::FaultKind;
 use crate::plot::{Color, Figure, HeatmapPanel, HeatmapRow, Marker, Series, Shade, SpectrumPanel};
 use crate::twin::diagnose::TwinDiagnosis;
+use bearingd::report::AnalyzeReport;
 
 fn fault_color(kind: FaultKind) -> Color {
     match kind {

@@ -8,12 +8,12 @@
 //!
 //! Reading and timing files happens here; the life itself is sans-IO ([`LifeTracker`]).
 
-use super::{CliError, RecordingArgs};
 use crate::analysis::health::CONFIRM_WINDOWS;
 use crate::life::{hindsight, LifeSettings, LifeTracker};
 use crate::offline::{resolve_conditions, AnalyzeRequest, OfflineError};
 use crate::recording::{read_recording, time_from_name};
 use crate::report::{life_figure, render_life_text, LifeReport, LifeSettingsReport, SkippedFile};
+use bearingd::cli::{CliError, RecordingArgs};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeSet;

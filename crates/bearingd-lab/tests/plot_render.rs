@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use bearingd::plot::{
+use bearingd_lab::plot::{
     self, Color, Figure, HeatmapPanel, HeatmapRow, Marker, PlotError, Series, Shade, SpectrumPanel,
 };
 use tiny_skia::Pixmap;

@@ -1,19 +1,35 @@
-//! `bearingd trend` on run-to-failure data (issue 13 item 4): on both FEMTO/PRONOSTIA dev
+//! `bearingd-lab trend` (`bearingd trend`) on run-to-failure data (issue 13 item 4): on both FEMTO/PRONOSTIA dev
 //! bearings the health stage never leaves "healthy" in the first half of life and the failure
 //! stage is entered before the end; on the IMS files (healthy, five snapshots) it never leaves
 //! healthy; unreadable snapshots are skipped, counted and named, never silently.
 
-use super::cli::{bearingd, stderr};
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
 use bearingd_testdata::{read_manifest, scratch_dir, shared_data_dir};
 use serde_json::Value;
 use std::collections::HashMap;
 use std::path::Path;
+use std::process::Output;
+
+fn lab(args: &[&str]) -> Output {
+    bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd-lab"), args)
+}
+
+/// The service binary, for `import`.
+fn bearingd(args: &[&str]) -> Output {
+    let service = bearingd_testdata::binary_beside(env!("CARGO_BIN_EXE_bearingd-lab"), "bearingd");
+    bearingd_testdata::run_binary(service.to_str().unwrap(), args)
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
 
 /// Runs `trend` with `extra` options and returns its JSON report.
 fn trend_json(dir: &Path, extra: &[&str]) -> Value {
     let mut args = vec!["trend", dir.to_str().unwrap(), "--format", "json"];
     args.extend_from_slice(extra);
-    let out = bearingd(&args);
+    let out = lab(&args);
     assert!(out.status.success(), "{args:?}: {}", stderr(&out));
     serde_json::from_slice(&out.stdout).expect("trend --format json prints JSON")
 }
@@ -151,7 +167,7 @@ fn unreadable_snapshots_are_skipped_counted_and_named() {
     }
     std::fs::write(dir.join("acc_00061.csv"), "not,a,pronostia\nfile\n").unwrap();
     std::fs::write(dir.join("notes.txt"), "written by hand").unwrap();
-    let out = bearingd(&["trend", dir.to_str().unwrap(), "--baseline", "3", "--no-hw"]);
+    let out = lab(&["trend", dir.to_str().unwrap(), "--baseline", "3", "--no-hw"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", stderr(&out));
     assert!(text.contains("6 snapshots"), "{text}");
@@ -172,7 +188,7 @@ fn unreadable_snapshots_are_skipped_counted_and_named() {
     // A directory with nothing usable is an input error naming the files.
     let empty = scratch_dir("trend-empty");
     std::fs::write(empty.join("acc_00001.csv"), "1,2\n").unwrap();
-    let out = bearingd(&["trend", empty.to_str().unwrap()]);
+    let out = lab(&["trend", empty.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(2));
     let err = stderr(&out);
     assert!(

@@ -1,0 +1,127 @@
+//! `analyze --plot`: the figure of a record, drawn by the lab. `bearingd analyze --plot` hands
+//! the whole command line to `bearingd-lab analyze`, which runs the service's analysis and adds
+//! the figure; without the lab, the service says how to get it.
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use bearingd_testdata::{binary_beside, run_binary, scratch_dir};
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+const LAB: &str = env!("CARGO_BIN_EXE_bearingd-lab");
+
+/// The service binary, built beside the lab (the hand-off is what is tested through it).
+fn service() -> PathBuf {
+    binary_beside(LAB, "bearingd")
+}
+
+fn bearingd(args: &[&str]) -> Output {
+    run_binary(service().to_str().unwrap(), args)
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+#[test]
+fn plots_are_written_as_png_and_svg() {
+    let dir = scratch_dir("cli-plot");
+    let png = dir.join("demo.png");
+    let svg = dir.join("demo.svg");
+    for path in [&png, &svg] {
+        let out = bearingd(&["analyze", "--demo", "--plot", path.to_str().unwrap()]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        // The service's text report, printed by the lab's run of the same command.
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("outer"), "{text}");
+    }
+    let bytes = std::fs::read(&png).unwrap();
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("<svg") && text.contains("BPFO") && text.contains("GK index"));
+    let gif = dir.join("demo.gif");
+    let out = bearingd(&["analyze", "--demo", "--plot", gif.to_str().unwrap()]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err}");
+    assert!(err.contains("demo.gif") && err.contains(".png"), "{err}");
+    assert!(err.starts_with("bearingd-lab: error:"), "{err}");
+}
+
+#[test]
+fn issue16_analyze_reports_velocity_rms_and_zone_of_an_analytic_sine() {
+    let dir = scratch_dir("severity-sine-plot");
+    let file = dir.join("sine.csv");
+    // 0.5 g at 80 Hz for 10 s at 12 kHz: 6.90 mm/s RMS, zone D below 600 rpm too.
+    let text: String = (0..120_000)
+        .map(|n| {
+            let t = n as f64 / 12_000.0;
+            format!("{}\n", 0.5 * (std::f64::consts::TAU * 80.0 * t).sin())
+        })
+        .collect();
+    std::fs::write(&file, text).unwrap();
+    let plot = dir.join("sine.svg");
+    let out = run_binary(
+        LAB,
+        &[
+            "analyze",
+            file.to_str().unwrap(),
+            "--fs",
+            "12000",
+            "--rpm",
+            "300",
+            "--bearing",
+            "skf-6205-2rs",
+            "--plot",
+            plot.to_str().unwrap(),
+        ],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("ISO 10816-3 velocity 6.9") && text.contains("zone D"),
+        "{text}"
+    );
+    let svg = std::fs::read_to_string(&plot).unwrap();
+    assert!(
+        svg.contains("velocity RMS per bin (mm/s)"),
+        "no velocity panel"
+    );
+    assert!(svg.contains("zone D"), "the plot does not show the zone");
+}
+
+/// The service alone (copied where no `bearingd-lab` is beside it, with no PATH to find one):
+/// `analyze --plot` and `trend` say how to get the lab; `analyze` without --plot still runs.
+#[test]
+fn without_the_lab_the_service_names_the_fix_and_still_analyzes() {
+    let dir = scratch_dir("service-alone");
+    let alone = dir.join("bearingd");
+    std::fs::copy(service(), &alone).unwrap();
+    let run = |args: &[&str]| {
+        Command::new(&alone)
+            .args(args)
+            .env("PATH", &dir)
+            .output()
+            .unwrap()
+    };
+    let svg = dir.join("demo.svg");
+    for (args, command) in [
+        (
+            vec!["analyze", "--demo", "--plot", svg.to_str().unwrap()],
+            "analyze --plot",
+        ),
+        (vec!["trend", dir.to_str().unwrap()], "trend"),
+    ] {
+        let out = run(&args);
+        let err = stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(&format!(
+                "`{command}` is a lab command: install bearingd-lab"
+            )) && err.contains("make install"),
+            "{args:?}: {err}"
+        );
+    }
+    assert!(!svg.exists());
+    let out = run(&["analyze", "--demo"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+}
