@@ -16,7 +16,7 @@
 //! ours either way, and one scene gives both formats the same picture.
 //!
 //! ```no_run
-//! use bearingd::plot::{self, Color, Figure, Marker, Series, SpectrumPanel};
+//! use bearingd_lab::plot::{self, Color, Figure, Marker, Series, SpectrumPanel};
 //! # fn main() -> Result<(), plot::PlotError> {
 //! let freqs: Vec<f64> = (0..2000).map(|i| i as f64 * 0.25).collect();
 //! let amplitude: Vec<f64> = freqs.iter().map(|f| (-(f - 105.9f64).powi(2)).exp()).collect();
