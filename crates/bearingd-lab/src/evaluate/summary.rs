@@ -293,9 +293,11 @@ pub fn render_confusion(
         .map(Predicted::name)
         .chain(extra_columns.iter().copied().filter(|c| occurred(c)))
         .collect();
+    // Each column as wide as its name and a space, at least 11 (`ball_or_inner` is 13).
+    let width = |c: &str| (c.len() + 1).max(11);
     let _ = write!(out, "{:<12}", "true\\said");
     for c in &columns {
-        let _ = write!(out, "{c:>11}");
+        let _ = write!(out, "{c:>w$}", w = width(c));
     }
     let _ = writeln!(out);
     for &name in rows {
@@ -304,7 +306,8 @@ pub fn render_confusion(
         };
         let _ = write!(out, "{name:<12}");
         for c in &columns {
-            let _ = write!(out, "{:>11}", row.get(*c).copied().unwrap_or(0));
+            let n = row.get(*c).copied().unwrap_or(0);
+            let _ = write!(out, "{n:>w$}", w = width(c));
         }
         let _ = writeln!(out);
     }
@@ -382,5 +385,23 @@ mod tests {
         // On a healthy record its two flags are false alarms.
         assert!(is_confident_wrong(None, ball_or_inner));
         assert!(!is_confident_wrong(None, Predicted::None));
+    }
+
+    #[test]
+    fn a_pair_column_is_as_wide_as_its_name() {
+        let mut confusion: BTreeMap<String, BTreeMap<String, u64>> = BTreeMap::new();
+        confusion
+            .entry("ball".into())
+            .or_default()
+            .insert("ball_or_inner".into(), 3);
+        let mut out = String::new();
+        render_confusion(&mut out, Path::Record, &confusion, &["ball"], &[]);
+        let header: Vec<&str> = out.lines().next().unwrap().split_whitespace().collect();
+        assert!(header.contains(&"ball_or_cage"), "{out}");
+        assert!(header.contains(&"ball_or_inner"), "{out}");
+        let row: Vec<&str> = out.lines().nth(1).unwrap().split_whitespace().collect();
+        assert_eq!(row.len(), header.len(), "{out}");
+        let at = header.iter().position(|c| *c == "ball_or_inner").unwrap();
+        assert_eq!(row[at], "3", "{out}");
     }
 }
