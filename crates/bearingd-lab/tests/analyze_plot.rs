@@ -52,13 +52,10 @@ fn issue16_analyze_reports_velocity_rms_and_zone_of_an_analytic_sine() {
     let dir = scratch_dir("severity-sine-plot");
     let file = dir.join("sine.csv");
     // 0.5 g at 80 Hz for 10 s at 12 kHz: 6.90 mm/s RMS, zone D below 600 rpm too.
-    let text: String = (0..120_000)
-        .map(|n| {
-            let t = n as f64 / 12_000.0;
-            format!("{}\n", 0.5 * (std::f64::consts::TAU * 80.0 * t).sin())
-        })
-        .collect();
-    std::fs::write(&file, text).unwrap();
+    bearingd_testdata::write_csv(
+        &file,
+        bearingd_testdata::sine_g(0.5, 80.0, 12_000.0, 120_000),
+    );
     let plot = dir.join("sine.svg");
     let out = run_binary(
         LAB,

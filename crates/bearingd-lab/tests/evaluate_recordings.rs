@@ -19,7 +19,7 @@ use bearingd_lab::evaluate::recordings::{
 };
 use bearingd_lab::evaluate::run::CaseSignal;
 use bearingd_lab::evaluate::{NoiseLevel, Sweep};
-use bearingd_testdata::{mcap_files, scratch_dir, shared_data_dir};
+use bearingd_testdata::{mcap_files, scratch_dir, shared_data_dir, write_csv};
 use std::collections::BTreeMap;
 use std::process::Command;
 
@@ -260,12 +260,8 @@ fn a_two_and_a_half_second_record_that_analyze_names_is_flagged_by_the_daemon() 
             column: None,
         };
         let full = bearingd::recording::read_recording(&cwru.join(record), &options).unwrap();
-        let short: String = full.samples[..30_000]
-            .iter()
-            .map(|x| format!("{x}\n"))
-            .collect();
         let name = record.replace(".mat", "_2.5s.csv");
-        std::fs::write(out.join(&name), short).unwrap();
+        write_csv(&out.join(&name), &full.samples[..30_000]);
         manifest.push_str(&format!(
             "{name},{fault},1797,12000,skf-6205-2rs,drive_end\n"
         ));
@@ -372,8 +368,7 @@ fn with_the_learned_agreement_the_daemon_flags_what_analyze_names() {
         .expect("the full sweep has the case");
     let signal = CaseSignal::of(&case, machine, &sweep.nuisance);
     let samples = Simulator::record(signal.params.clone(), 10.0);
-    let csv: String = samples.iter().map(|x| format!("{x}\n")).collect();
-    std::fs::write(out.join("weak_outer.csv"), csv).unwrap();
+    write_csv(&out.join("weak_outer.csv"), &samples);
     let path = out.join("manifest.csv");
     std::fs::write(
         &path,
@@ -443,8 +438,7 @@ fn a_ball_or_inner_verdict_agrees_with_the_daemon_raising_that_pair() {
         ..SimulationParams::example(SimulatedFault::InnerRace)
     };
     let samples = Simulator::record(params.clone(), 10.0);
-    let csv: String = samples.iter().map(|x| format!("{x}\n")).collect();
-    std::fs::write(out.join("uniform_inner_61804.csv"), csv).unwrap();
+    write_csv(&out.join("uniform_inner_61804.csv"), &samples);
     let path = out.join("manifest.csv");
     std::fs::write(
         &path,

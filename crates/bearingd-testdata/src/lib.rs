@@ -270,6 +270,18 @@ pub fn log_topics_with_python(py: &Path, file: &Path) -> Vec<serde_json::Value> 
     summary["messages"].as_array().cloned().unwrap_or_default()
 }
 
+/// Writes `samples` to `path` as a one-column CSV, one value per line (a record a user might
+/// have, in g).
+pub fn write_csv<T: std::fmt::Display>(path: &Path, samples: impl IntoIterator<Item = T>) {
+    let text: String = samples.into_iter().map(|x| format!("{x}\n")).collect();
+    std::fs::write(path, text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+}
+
+/// `n` samples at `fs_hz` of a sine of peak `amplitude_g` at `f_hz`.
+pub fn sine_g(amplitude_g: f64, f_hz: f64, fs_hz: f64, n: usize) -> impl Iterator<Item = f64> {
+    (0..n).map(move |i| amplitude_g * (std::f64::consts::TAU * f_hz * i as f64 / fs_hz).sin())
+}
+
 /// A deterministic pseudo-random byte stream (xorshift), for files that are not logs.
 pub fn noise(len: usize, mut seed: u64) -> Vec<u8> {
     (0..len)
