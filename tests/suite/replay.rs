@@ -20,8 +20,11 @@ fn stderr_of(out: &Output) -> String {
 }
 
 /// The embedded default at `rate_hz`, files rotated every `file_s` of log time, an iceoryx2
-/// root of its own; written to `dir/<name>.toml`.
+/// root of its own (numbered per call: two tests may run the same `name` at once); written to
+/// `dir/<name>.toml`.
 fn config_at(dir: &Path, name: &str, rate_hz: u32, file_s: u32) -> PathBuf {
+    static CONFIGS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let number = CONFIGS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let out = bearingd(&["config", "default"]);
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout)
@@ -36,7 +39,10 @@ fn config_at(dir: &Path, name: &str, rate_hz: u32, file_s: u32) -> PathBuf {
         )
         .replace(
             "\"/run/bearingd/iceoryx2\"",
-            &format!("\"/dev/shm/bearingd-replay-{name}-{}\"", std::process::id()),
+            &format!(
+                "\"/dev/shm/bearingd-replay-{name}-{}-{number}\"",
+                std::process::id()
+            ),
         );
     assert!(text.contains(&format!("sample_rate_hz = {rate_hz}")));
     let path = dir.join(format!("{name}.toml"));
