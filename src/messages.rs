@@ -20,10 +20,11 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 
 pub mod detect;
-mod velocity;
 
+pub use detect::velocity::{
+    VelocityFlagMessage, VelocityMessage, ISO_ZONE_FLAG, VELOCITY_FLAG_NAME,
+};
 pub use detect::DetectorMessage;
-pub use velocity::{VelocityFlagMessage, VelocityMessage, ISO_ZONE_FLAG, VELOCITY_FLAG_NAME};
 
 /// Implements `Display` as the variant's wire name (`name()`), so text output and the log agree.
 macro_rules! display_as_name {
@@ -194,7 +195,7 @@ display_as_name!(FlagLevel, HealthStage, HealthKind, SpeedSource, IsoZone);
 
 /// Identifies one analysed signal: a sensor (node) and one of its axes.
 #[derive(
-    Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
+    Debug, Clone, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize, JsonSchema,
 )]
 pub struct ChannelId {
     /// The sensor's id from the config (e.g. `motor-de`).

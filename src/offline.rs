@@ -7,6 +7,8 @@
 //! resolved is an error that says which option gives it.
 
 use crate::analysis::defect_size::measure_for_verdict;
+use crate::analysis::detect::RecordView;
+use crate::analysis::detectors::DetectorSettings;
 use crate::analysis::iso::{record_severity, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
@@ -348,6 +350,15 @@ pub fn analyze_recording(
     } else {
         report.velocity =
             record_severity(&mut analyzer.plans, &samples, fs_hz, rpm, request.severity);
+    }
+    let record = RecordView {
+        shaft_hz: rpm / 60.0,
+        velocity: report.velocity.as_ref(),
+    };
+    let detectors = DetectorSettings::for_records().with_severity(request.severity);
+    for found in detectors.analyze_record(&record) {
+        report.detectors.insert(found.key.to_string(), found.json);
+        report.detector_lines.extend(found.lines);
     }
     let twin = request.twin.then(|| {
         let band_of = |kind: FaultKind| {

@@ -122,7 +122,9 @@ fn a_monitor_takes_hops_and_speed_changes_without_allocating() {
             max_shaft_hz: shaft * 1.5,
         },
         // The velocity severity (ISO zones) and its flag run every half window too.
-        severity: Some(bearingd::analysis::iso::SeveritySettings::default()),
+        detectors: bearingd::analysis::detectors::DetectorSettings {
+            severity: Some(bearingd::analysis::iso::SeveritySettings::default()),
+        },
         trend: bearingd::analysis::monitor::TrendSettings::default(),
     };
     let mut monitor = ChannelMonitor::new(settings, params.frequencies(), None);

@@ -24,6 +24,8 @@ pub mod band_search;
 pub mod band_selection;
 pub mod defect_size;
 pub mod degradation;
+pub mod detect;
+pub mod detectors;
 pub mod diagnosis;
 pub mod envelope;
 pub mod fault_bands;
@@ -39,6 +41,7 @@ pub mod record;
 pub mod rolling_element;
 pub mod settings;
 pub mod speed;
+pub mod velocity;
 
 pub use band::Band;
 pub use diagnosis::{Diagnosis, Verdict};

@@ -467,12 +467,13 @@ pub fn status_line(s: &ChannelStatus) -> String {
         (None, SpeedSource::Estimate) => "?(no estimate yet: scoring waits)".to_string(),
         (None, _) => "?(no usable speed frame: scoring waits)".to_string(),
     };
-    let iso = match (s.zone, s.velocity_mm_s) {
-        (Some(zone), Some(v)) => format!("{zone}({v:.2}mm/s)"),
-        _ => "-".into(),
-    };
+    let readings: String = s
+        .readings
+        .iter()
+        .map(|(key, text)| format!(" {key}={text}"))
+        .collect();
     format!(
-        "{} t={:.1}s rpm={} band={} top={} twin={} stage={} iso={} flags={}{}{}",
+        "{} t={:.1}s rpm={} band={} top={} twin={} stage={}{} flags={}{}{}",
         s.channel,
         s.seconds,
         rpm,
@@ -480,7 +481,7 @@ pub fn status_line(s: &ChannelStatus) -> String {
         top,
         twin,
         s.stage,
-        iso,
+        readings,
         s.flags_summary(),
         if s.gaps > 0 {
             format!(" GAPS {} ({} samples missing)", s.gaps, s.missing_samples)

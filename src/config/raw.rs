@@ -63,6 +63,9 @@ pub(crate) struct RawConfig {
     pub outputs: RawOutputs,
     pub fleet: RawFleet,
     pub severity: RawSeverity,
+    /// `[detectors.<name>]`: read by serde into the detectors' own settings
+    /// ([`crate::analysis::detectors`]), checked there.
+    pub detectors: crate::analysis::detectors::DetectorSettings,
 }
 
 #[derive(Debug, Default, Deserialize)]

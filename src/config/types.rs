@@ -38,6 +38,10 @@ pub struct Config {
     /// before the section existed have none: read as the default.
     #[serde(default)]
     pub severity: SeveritySettings,
+    /// The detectors turned on by a `[detectors.<name>]` section, with their settings. Logs
+    /// written before the list existed have none.
+    #[serde(default)]
+    pub detectors: crate::analysis::detectors::DetectorSettings,
 }
 
 impl Config {

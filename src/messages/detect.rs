@@ -7,17 +7,18 @@
 //! name every detector's messages, and `messages` is the bottom room that the analysis, the
 //! MCAP log and every sink build on (`src/lib.rs` "# Layout"); a list in `analysis` would make
 //! `messages` depend on a room above it. So the message half of a detector lives here (its
-//! records in a file of their own, `messages/velocity.rs`), the computing half in `analysis`.
+//! records in a file of their own, `messages/detect/<name>.rs`), the computing half in
+//! `analysis`.
 //!
 //! What is generic then (no per-detector code): the MCAP log's topics, schemas, encoding and
 //! decoding ([`RecordKind`]), late flag changes, the accessors (`channel`, `end_sample`),
 //! alerts (score, confidence, the code and name of [`FlagSpec`]), `bearingd alerts`' and
 //! `run`'s flag lines, the status flags and the fleet's metrics ([`MetricSpec`]).
 //!
-//! A new detector: its records in `messages/<name>.rs` (the [`Record`] and [`FlagRecord`]
-//! impls), one line in `detectors!`, its computation in `analysis`; until the monitor runs
-//! detectors through a trait of their own (issue 31 step C3), its events still become messages
-//! in `pipeline::handle_event`.
+//! A new detector: its records in `messages/detect/<name>.rs` (the [`Record`] and
+//! [`FlagRecord`] impls), one line in `detectors!`, its computation in `analysis` (a
+//! `ChannelDetector`, listed in `analysis::detectors`; docs/ARCHITECTURE.md "Where a new part
+//! goes").
 //!
 //! Dispatch: one `match` per message (generated) to a `&dyn` [`AnyRecord`]: a vtable call per
 //! low-rate message (a reading every half second per channel), no allocation, and far less
@@ -30,6 +31,8 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 
 use super::{ChannelId, FlagLevel, PipelineMessage};
+
+pub mod velocity;
 
 /// A flag of a detector: how alerts, status lines and the command line name it, and its code in
 /// the iceoryx2 alert (1–4 are the bearing faults).
@@ -72,6 +75,9 @@ pub trait Stamped {
     fn channel(&self) -> &ChannelId;
     /// One past the last sample the record covers.
     fn end_sample(&self) -> u64;
+    /// Puts the record on `channel`: a detector makes its records without knowing its
+    /// channel's name, the pipeline stamps them.
+    fn set_channel(&mut self, channel: ChannelId);
 }
 
 /// Implements [`Stamped`] for records with the usual `channel` and `end_sample` fields.
@@ -84,6 +90,10 @@ macro_rules! stamped_by_fields {
 
             fn end_sample(&self) -> u64 {
                 self.end_sample
+            }
+
+            fn set_channel(&mut self, channel: ChannelId) {
+                self.channel = channel;
             }
         }
     )+};
@@ -108,6 +118,12 @@ pub trait Record:
 
     /// The record as a flag change, if it is one (flag records return `Some(self)`).
     fn as_flag(&self) -> Option<&dyn FlagRecord> {
+        None
+    }
+
+    /// What the channel's status line shows of the reading, as `(key, value)`
+    /// (`("iso", "B(2.10mm/s)")`); `None`: nothing.
+    fn status(&self) -> Option<(&'static str, String)> {
         None
     }
 }
@@ -181,6 +197,7 @@ pub trait AnyRecord: Stamped {
     fn write_json(&self, out: &mut Vec<u8>) -> serde_json::Result<()>;
     fn as_flag(&self) -> Option<&dyn FlagRecord>;
     fn metrics(&self, out: &mut dyn FnMut(usize, MetricValue<'_>));
+    fn status(&self) -> Option<(&'static str, String)>;
 }
 
 impl<R: Record> AnyRecord for R {
@@ -194,6 +211,10 @@ impl<R: Record> AnyRecord for R {
 
     fn metrics(&self, out: &mut dyn FnMut(usize, MetricValue<'_>)) {
         Record::metrics(self, out)
+    }
+
+    fn status(&self) -> Option<(&'static str, String)> {
+        Record::status(self)
     }
 }
 
@@ -259,6 +280,11 @@ impl DetectorMessage {
     pub fn as_flag(&self) -> Option<&dyn FlagRecord> {
         self.record().1.as_flag()
     }
+
+    /// What the channel's status line shows of the message ([`Record::status`]).
+    pub fn status(&self) -> Option<(&'static str, String)> {
+        self.record().1.status()
+    }
 }
 
 /// The one list of detectors: `Name { reading: Type, flag: Type }` per detector. Generates
@@ -312,6 +338,16 @@ macro_rules! detectors {
                             RecordKind { detector: DetectorId::$name, role: Role::Flag },
                             f,
                         ),
+                    )+
+                }
+            }
+
+            /// Puts the message on `channel` ([`Stamped::set_channel`]).
+            pub fn set_channel(&mut self, channel: ChannelId) {
+                match self {
+                    $(
+                        DetectorMessage::$name(Emitted::Reading(r)) => r.set_channel(channel),
+                        DetectorMessage::$name(Emitted::Flag(f)) => f.set_channel(channel),
                     )+
                 }
             }

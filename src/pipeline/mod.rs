@@ -35,12 +35,11 @@ use crate::analysis::speed::{SpeedMode, SpeedSearch};
 use crate::analysis::Band;
 use crate::bearing::FaultFrequencies;
 use crate::config::{Config, SensorConfig, Speed};
-use crate::messages::detect::{all_flags, FlagRecord};
+use crate::messages::detect::all_flags;
 use crate::messages::{
     AlertMessage, ChannelId, FaultKind, FlagLevel, FlagMessage, HealthKind, HealthMessage,
-    HealthStage, IndicatorsMessage, IngestMessage, IsoZone, PipelineMessage, RawBlock,
-    SpectrumMessage, SpeedMessage, SpeedSource, TrendMessage, TwinMessage, VelocityFlagMessage,
-    VelocityMessage, ISO_ZONE_FLAG,
+    HealthStage, IndicatorsMessage, IngestMessage, PipelineMessage, RawBlock, SpectrumMessage,
+    SpeedMessage, SpeedSource, TrendMessage, TwinMessage,
 };
 use alerts::{history_size_for, pass_on, AlertTracker};
 use serde::Serialize;
@@ -137,9 +136,9 @@ pub struct ChannelStatus {
     pub twin_error: Option<f64>,
     pub sensor_lost: bool,
     pub flag_changes: u64,
-    /// The latest ISO velocity RMS (mm/s) and its zone; `None` before the first reading.
-    pub velocity_mm_s: Option<f64>,
-    pub zone: Option<IsoZone>,
+    /// What the detectors' latest readings show, by key (`("iso", "B(2.10mm/s)")`), in the
+    /// order they first came.
+    pub readings: Vec<(&'static str, String)>,
     /// Every registered detector's flags by name, in registry order (the velocity zone flag
     /// `iso_zone`: watch in zone C, alarm in zone D).
     pub detector_flags: Vec<(&'static str, FlagLevel)>,
@@ -165,6 +164,14 @@ impl ChannelStatus {
             "ok".to_string()
         } else {
             raised.join(",")
+        }
+    }
+
+    /// Keeps `text` as the latest reading shown under `key`.
+    fn set_reading(&mut self, key: &'static str, text: String) {
+        match self.readings.iter_mut().find(|(k, _)| *k == key) {
+            Some((_, shown)) => *shown = text,
+            None => self.readings.push((key, text)),
         }
     }
 
@@ -248,7 +255,7 @@ pub fn monitor_settings(
                 range: search,
             }),
         },
-        severity: Some(config.severity),
+        detectors: config.detectors.clone().with_severity(config.severity),
     }
 }
 
@@ -384,8 +391,7 @@ impl Pipeline {
                     twin_error: None,
                     sensor_lost: false,
                     flag_changes: 0,
-                    velocity_mm_s: None,
-                    zone: None,
+                    readings: Vec::new(),
                     detector_flags: all_flags().map(|f| (f.name, FlagLevel::Ok)).collect(),
                 };
                 let fs_hz = sensor.sample_rate_hz;
@@ -656,42 +662,15 @@ fn handle_event(
                 runner_up_score: Some(runner_up),
             })
         }
-        MonitorEvent::Velocity {
-            reading,
-            band_hz,
-            flag,
-        } => {
-            status.velocity_mm_s = Some(reading.rms_mm_s);
-            status.zone = Some(reading.zone);
-            status.set_detector_flag(ISO_ZONE_FLAG.name, flag);
-            VelocityMessage {
-                channel: channel.clone(),
-                end_sample: reading.end_sample,
-                rms_mm_s: reading.rms_mm_s,
-                zone: reading.zone,
-                band_hz: [band_hz.0, band_hz.1],
-                windows_averaged: reading.windows_averaged,
-                flag,
+        MonitorEvent::Detector(mut message) => {
+            message.set_channel(channel.clone());
+            if let Some((key, text)) = message.status() {
+                status.set_reading(key, text);
             }
-            .into()
-        }
-        MonitorEvent::VelocityFlag {
-            change,
-            reading,
-            limits,
-        } => {
-            let flag = VelocityFlagMessage {
-                channel: channel.clone(),
-                end_sample: change.at_sample,
-                from: change.from,
-                to: change.to,
-                rms_mm_s: reading.rms_mm_s,
-                zone: reading.zone,
-                watch_mm_s: limits.bc_mm_s,
-                alarm_mm_s: limits.cd_mm_s,
-            };
-            status.set_detector_flag(flag.flag().name, flag.change().1);
-            flag.into()
+            if let Some(flag) = message.as_flag() {
+                status.set_detector_flag(flag.flag().name, flag.change().1);
+            }
+            PipelineMessage::Detector(message)
         }
         MonitorEvent::Trend { point, stage } => PipelineMessage::Trend(TrendMessage {
             channel: channel.clone(),

@@ -144,6 +144,13 @@ pub struct AnalyzeReport {
     /// ISO 10816-3 / 20816-3 velocity severity and zone; `null` when the record is not in g
     /// (WAV) or too short.
     pub velocity: Option<VelocitySeverity>,
+    /// What the detectors that judge whole records found, each under its own key
+    /// (`machine_faults`; [`crate::analysis::detectors`]).
+    #[serde(flatten)]
+    pub detectors: serde_json::Map<String, serde_json::Value>,
+    /// The same for people: lines of the text report.
+    #[serde(skip)]
+    pub detector_lines: Vec<String>,
     /// The signal-model twin's fit (`analyze --twin`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub twin: Option<TwinReport>,
@@ -452,6 +459,8 @@ impl AnalyzeReport {
                 })
                 .collect(),
             velocity: None,
+            detectors: serde_json::Map::new(),
+            detector_lines: Vec::new(),
             twin: None,
             learned: None,
             defect_size_mm: None,

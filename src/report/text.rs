@@ -147,6 +147,9 @@ pub fn render_text(r: &AnalyzeReport) -> String {
     if let Some(v) = &r.velocity {
         let _ = writeln!(out, "  {}", v.summary());
     }
+    for line in &r.detector_lines {
+        let _ = writeln!(out, "  {line}");
+    }
     for w in &r.warnings {
         let _ = writeln!(out, "  warning: {w}");
     }

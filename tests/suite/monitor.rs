@@ -6,7 +6,8 @@ use bearingd::analysis::flags::FlagSettings;
 use bearingd::analysis::monitor::{ChannelMonitor, MonitorEvent, MonitorSettings};
 use bearingd::analysis::speed::SpeedMode;
 use bearingd::analysis::AnalysisSettings;
-use bearingd::messages::{FlagLevel, HealthKind, HealthStage};
+use bearingd::messages::detect::Emitted;
+use bearingd::messages::{DetectorMessage, FlagLevel, HealthKind, HealthStage};
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
 
 const SCALE: f64 = 0.000_488;
@@ -32,7 +33,8 @@ fn settings(fs: f64) -> MonitorSettings {
         flat_line_samples: fs as u64,
         speed: SpeedMode::Fixed,
         // The velocity severity runs too: its readings must not depend on block sizes either.
-        severity: Some(bearingd::analysis::iso::SeveritySettings::default()),
+        detectors: bearingd::analysis::detectors::DetectorSettings::default()
+            .with_severity(bearingd::analysis::iso::SeveritySettings::default()),
         trend: bearingd::analysis::monitor::TrendSettings::default(),
     }
 }
@@ -126,14 +128,15 @@ fn describe(event: MonitorEvent, events: &mut Vec<String>) {
             shaft_hz,
             ..
         } => events.push(format!("speed {shaft_hz:?} at {at_sample}")),
-        MonitorEvent::Velocity { reading, flag, .. } => events.push(format!(
-            "velocity {:.6} mm/s zone {} flag {flag} at {}",
-            reading.rms_mm_s, reading.zone, reading.end_sample
-        )),
-        MonitorEvent::VelocityFlag { change, .. } => events.push(format!(
-            "velocity flag {:?}->{:?} at {}",
-            change.from, change.to, change.at_sample
-        )),
+        MonitorEvent::Detector(DetectorMessage::Velocity(Emitted::Reading(r))) => {
+            events.push(format!(
+                "velocity {:.6} mm/s zone {} flag {} at {}",
+                r.rms_mm_s, r.zone, r.flag, r.end_sample
+            ))
+        }
+        MonitorEvent::Detector(DetectorMessage::Velocity(Emitted::Flag(f))) => events.push(
+            format!("velocity flag {:?}->{:?} at {}", f.from, f.to, f.end_sample),
+        ),
         MonitorEvent::Window(_) => {}
     }
 }
@@ -461,10 +464,12 @@ fn the_velocity_zone_flag_rises_and_falls_with_the_fault_flags_hysteresis() {
     let (mut readings, mut changes) = (Vec::new(), Vec::new());
     for (i, block) in counts.chunks(1_000).enumerate() {
         monitor.push_counts((i * 1_000) as u64, block, SCALE, &mut |e| match e {
-            MonitorEvent::Velocity { reading, .. } => readings.push(reading),
-            MonitorEvent::VelocityFlag { change, limits, .. } => {
-                assert_eq!((limits.bc_mm_s, limits.cd_mm_s), (2.8, 4.5));
-                changes.push(change)
+            MonitorEvent::Detector(DetectorMessage::Velocity(Emitted::Reading(r))) => {
+                readings.push(r)
+            }
+            MonitorEvent::Detector(DetectorMessage::Velocity(Emitted::Flag(f))) => {
+                assert_eq!((f.watch_mm_s, f.alarm_mm_s), (2.8, 4.5));
+                changes.push(f)
             }
             _ => {}
         });
@@ -485,7 +490,7 @@ fn the_velocity_zone_flag_rises_and_falls_with_the_fault_flags_hysteresis() {
         .unwrap();
     let got: Vec<_> = changes
         .iter()
-        .map(|c| (c.from, c.to, c.at_sample))
+        .map(|c| (c.from, c.to, c.end_sample))
         .collect();
     assert_eq!(
         got,
@@ -533,7 +538,9 @@ fn a_window_stagger_moves_every_window_end_by_its_share_of_the_hop() {
         for (i, block) in counts.chunks(1_000).enumerate() {
             monitor.push_counts((i * 1_000) as u64, block, SCALE, &mut |e| match e {
                 MonitorEvent::Window(w) => windows.push(w.end_sample),
-                MonitorEvent::Velocity { reading, .. } => velocity.push(reading.end_sample),
+                MonitorEvent::Detector(DetectorMessage::Velocity(Emitted::Reading(r))) => {
+                    velocity.push(r.end_sample)
+                }
                 _ => {}
             });
         }

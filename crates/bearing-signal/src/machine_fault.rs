@@ -16,13 +16,14 @@
 //! only widen the lines).
 
 use crate::random::Rng;
+use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
 /// Standard gravity, m/s² per g.
 const G: f64 = 9.806_65;
 
 /// Which machine fault.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize, JsonSchema)]
 #[serde(rename_all = "snake_case")]
 pub enum MachineFaultKind {
     Unbalance,

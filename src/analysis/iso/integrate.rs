@@ -115,8 +115,13 @@ impl VelocityIntegrator {
     /// The same mean square from the *unwindowed* real FFT of the same window (the envelope's,
     /// `window / 2 + 1` bins), which saves the daemon one window FFT per hop: a periodic Hann
     /// window is, in the frequency domain, `Xw[k] = ½X[k] − ¼(X[k−1] + X[k+1])`, and the mean
-    /// reaches only bins 0 and 1, below the band ([`Self::takes_unwindowed`]).
-    pub fn mean_square_of_unwindowed(&self, spectrum: &[Complex32]) -> f64 {
+    /// reaches only bins 0 and 1, below the band ([`Self::takes_unwindowed`]). `per_bin`, if
+    /// given, gets each bin's share added, as in [`Self::mean_square`].
+    pub fn mean_square_of_unwindowed(
+        &self,
+        spectrum: &[Complex32],
+        per_bin: Option<&mut [f64]>,
+    ) -> f64 {
         let n = self.input.len();
         if spectrum.len() != n / 2 + 1 {
             return f64::NAN;
@@ -129,7 +134,7 @@ impl VelocityIntegrator {
                 spectrum[n - k].conj()
             }
         };
-        self.in_band(|k| bin(k) * 0.5 - (bin(k - 1) + bin(k + 1)) * 0.25, None)
+        self.in_band(|k| bin(k) * 0.5 - (bin(k - 1) + bin(k + 1)) * 0.25, per_bin)
     }
 
     /// Whether [`Self::mean_square_of_unwindowed`] applies: the band starts above bin 1.

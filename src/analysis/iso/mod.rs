@@ -21,7 +21,8 @@
 //!
 //! The files: `zones` (the standard's machine groups, foundations, zone boundaries and
 //! band), `integrate` (acceleration windows to velocity, and the severity of a whole record),
-//! `tracker` (the rolling per-channel reading of the daemon).
+//! `tracker` (the rolling per-channel reading of the daemon). The daemon's detector (the reading
+//! and its zone flag) is `analysis::velocity`.
 
 mod integrate;
 mod tracker;

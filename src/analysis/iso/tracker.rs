@@ -172,7 +172,7 @@ impl VelocityTracker {
         end_sample: u64,
     ) -> VelocityReading {
         self.samples = end_sample;
-        let ms = self.integrator.mean_square_of_unwindowed(spectrum);
+        let ms = self.integrator.mean_square_of_unwindowed(spectrum, None);
         self.record(ms)
     }
 

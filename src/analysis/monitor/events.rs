@@ -1,15 +1,14 @@
 //! What a channel monitor tells its driver: per-hop reports, flag, stage, sensor, band,
-//! velocity, gap and speed events, all stamped in sample time.
+//! detector, gap and speed events, all stamped in sample time.
 
 use crate::analysis::band_selection::Evidence;
 use crate::analysis::degradation::TrendPoint;
 use crate::analysis::fault_bands::FaultScore;
-use crate::analysis::flags::{FaultFlag, FlagChange};
+use crate::analysis::flags::FlagChange;
 use crate::analysis::health::StageChange;
 use crate::analysis::indicators::Indicators;
-use crate::analysis::iso::{VelocityReading, ZoneLimits};
 use crate::analysis::Band;
-use crate::messages::{FaultKind, FlagLevel, HealthKind, HealthStage};
+use crate::messages::{DetectorMessage, FaultKind, HealthKind, HealthStage};
 
 /// A sensor-health finding.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -72,18 +71,9 @@ pub enum MonitorEvent<'a> {
         evidence: Option<&'a Evidence>,
         evidence_from: u64,
     },
-    /// A velocity reading ([`crate::analysis::iso`]) and the zone flag's level after it.
-    Velocity {
-        reading: VelocityReading,
-        band_hz: (f64, f64),
-        flag: FlagLevel,
-    },
-    /// The velocity zone flag changed level.
-    VelocityFlag {
-        change: FlagChange,
-        reading: VelocityReading,
-        limits: ZoneLimits,
-    },
+    /// A detector's reading or flag change ([`crate::analysis::detect`]); its channel is left
+    /// empty for the driver to fill in.
+    Detector(DetectorMessage),
     /// Samples were missing: the windows restart after the gap.
     Gap {
         at_sample: u64,
@@ -100,26 +90,4 @@ pub enum MonitorEvent<'a> {
         given_hz: Option<f64>,
         estimated: bool,
     },
-}
-
-/// The events of one velocity reading: its zone flag's change, if any, then the reading.
-pub(super) fn velocity_events(
-    reading: VelocityReading,
-    band_hz: (f64, f64),
-    limits: ZoneLimits,
-    flag: &mut FaultFlag,
-    on_event: &mut impl FnMut(MonitorEvent),
-) {
-    if let Some(change) = flag.update(reading.rms_mm_s, reading.end_sample) {
-        on_event(MonitorEvent::VelocityFlag {
-            change,
-            reading,
-            limits,
-        });
-    }
-    on_event(MonitorEvent::Velocity {
-        reading,
-        band_hz,
-        flag: flag.level(),
-    });
 }

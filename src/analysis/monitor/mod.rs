@@ -33,12 +33,9 @@
 //!   effect at a sample, so a replay that feeds the logged changes at their samples repeats
 //!   every event.
 //!
-//! - Velocity severity ([`super::iso`]): every half window of the velocity analysis (1.28 s
-//!   windows at 25.6 kHz) the velocity RMS in the ISO band over the last `averages` windows,
-//!   its zone, and a zone flag (watch in zone C, alarm in zone D) on the fault flags'
-//!   [`FaultFlag`] with their clear ratio and delays. Independent of the speed (the band is
-//!   chosen once, from the starting speed) and of the band selection: it runs from the first
-//!   window on.
+//! - Detectors ([`super::detect`], listed in [`super::detectors`]): given every block and every
+//!   envelope window, they emit their own messages (the ISO velocity reading and its zone
+//!   flag, …). Independent of the band selection: they run from the first window on.
 //!
 //! - Band selections run as jobs ([`super::band_selection`]): inline by default; with
 //!   [`ChannelMonitor::with_band_selector`] on another thread, their results used a fixed number
@@ -62,17 +59,17 @@ use super::agreement::Witness;
 use super::band::envelope_range_hz;
 use super::band_selection::{scaled, usable_shaft_hz, BandSelector, InlineSelector};
 use super::degradation::RmsTrend;
+use super::detect::{share_of, ChannelContext, ChannelDetector, WindowView};
 use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::FaultFlag;
 use super::health::{Baseline, HealthTracker, CONFIRM_WINDOWS};
 use super::indicators::Indicators;
-use super::iso::VelocityTracker;
 use super::speed::SpeedMode;
 use super::Band;
 use crate::bearing::FaultFrequencies;
+use crate::messages::detect::FlagSpec;
 use crate::messages::{FaultKind, FlagLevel, HealthStage};
-use events::velocity_events;
 use sensor::SensorWatch;
 
 /// The streaming analysis of one channel.
@@ -126,17 +123,12 @@ pub struct ChannelMonitor {
     /// The signal has ended ([`Self::finish`]): a verdict on less than a whole horizon moves
     /// the flags too.
     ending: bool,
-    /// The velocity severity and its zone flag (`None` when off).
-    velocity: Option<(VelocityTracker, FaultFlag)>,
+    /// The detectors run besides the fault scores ([`MonitorSettings::detectors`]).
+    detectors: Vec<Box<dyn ChannelDetector>>,
 }
 
 /// Samples converted per chunk (the scratch buffer's size).
 const CHUNK: usize = 4096;
-
-/// The k/n share of `hop` of the k-th of n channels ([`MonitorSettings::window_stagger`]).
-fn share_of(hop: usize, (k, n): (usize, usize)) -> usize {
-    (hop * k.min(n)) / n.max(1)
-}
 
 impl ChannelMonitor {
     pub fn new(
@@ -167,22 +159,19 @@ impl ChannelMonitor {
             bins,
         );
         let scores = scorer.score_all(&[], bin_hz, &freqs);
-        let velocity = settings.severity.map(|severity| {
-            let tracker = VelocityTracker::new(
-                settings.fs_hz,
-                freqs.shaft * 60.0,
-                severity,
-                settings.analysis.averages,
-                // The process's cache: plans and Hann windows once per size, not per channel.
-                &mut crate::analysis::envelope::FftPlans::shared(),
-            );
-            let phase = share_of(tracker.hop(), settings.window_stagger);
-            let tracker = tracker.with_phase(phase).share_windows_with(window, hop);
-            let flag = FaultFlag::new(tracker.limits().flag_settings(&settings.flags));
-            (tracker, flag)
+        let detectors = settings.detectors.build(&mut ChannelContext {
+            fs_hz: settings.fs_hz,
+            shaft_hz: freqs.shaft,
+            window,
+            hop,
+            window_stagger: settings.window_stagger,
+            averages: settings.analysis.averages,
+            flags: &settings.flags,
+            // The process's cache: plans and Hann windows once per size, not per channel.
+            plans: &mut crate::analysis::envelope::FftPlans::shared(),
         });
         ChannelMonitor {
-            velocity,
+            detectors,
             rolling: RollingEnvelope::new(
                 settings.fs_hz,
                 window,
@@ -350,9 +339,11 @@ impl ChannelMonitor {
         self.flags.each_ref().map(|f| f.level())
     }
 
-    /// The velocity zone flag's level; `None` when the velocity analysis is off.
-    pub fn velocity_flag(&self) -> Option<FlagLevel> {
-        self.velocity.as_ref().map(|(_, flag)| flag.level())
+    /// Each running detector's flags with their levels.
+    pub fn detector_flags(&self, out: &mut dyn FnMut(&'static FlagSpec, FlagLevel)) {
+        for detector in &self.detectors {
+            detector.flag_levels(out);
+        }
     }
 
     pub fn health(&self) -> &HealthTracker {
@@ -394,8 +385,8 @@ impl ChannelMonitor {
                 });
             }
             self.rolling.restart_at(first_sample);
-            if let Some((tracker, _)) = &mut self.velocity {
-                tracker.restart_at(first_sample);
+            for detector in &mut self.detectors {
+                detector.restart_at(first_sample);
             }
             self.history_filled = 0;
             self.next_sample = first_sample;
@@ -472,17 +463,13 @@ impl ChannelMonitor {
         self.history_filled = (self.history_filled + samples.len()).min(n);
         self.next_sample += samples.len() as u64;
 
-        // A tracker that shares the envelope's windows reads in the envelope's update below.
-        if let Some((tracker, flag)) = &mut self.velocity {
-            let (band_hz, limits) = (tracker.band(), tracker.limits());
-            tracker.push(samples, |reading| {
-                velocity_events(reading, band_hz, limits, flag, on_event);
-            });
+        for detector in &mut self.detectors {
+            detector.on_samples(samples, &mut |m| on_event(MonitorEvent::Detector(m)));
         }
 
         let ChannelMonitor {
             rolling,
-            velocity,
+            detectors,
             scorer,
             health,
             trend,
@@ -510,11 +497,13 @@ impl ChannelMonitor {
                 }
                 scores[i] = scorer.score_prepared(slot(i), spectrum, *kind, freqs);
             }
-            if let Some((tracker, flag)) = velocity.as_mut().filter(|(t, _)| t.shares_windows()) {
-                let reading =
-                    tracker.reading_of_unwindowed(update.window_spectrum, update.end_sample);
-                let (band_hz, limits) = (tracker.band(), tracker.limits());
-                velocity_events(reading, band_hz, limits, flag, on_event);
+            let window = WindowView {
+                end_sample: update.end_sample,
+                spectrum: update.window_spectrum,
+                shaft_hz: speed_known.then_some(freqs.shaft),
+            };
+            for detector in detectors.iter_mut() {
+                detector.on_window(&window, &mut |m| on_event(MonitorEvent::Detector(m)));
             }
             let indicators =
                 Indicators::of_slices(&[update.window_samples.0, update.window_samples.1]);

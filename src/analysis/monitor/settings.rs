@@ -1,7 +1,7 @@
 //! What a channel monitor is given: everything it needs, with durations already in samples.
 
+use crate::analysis::detectors::DetectorSettings;
 use crate::analysis::flags::FlagSettings;
-use crate::analysis::iso::SeveritySettings;
 use crate::analysis::speed::SpeedMode;
 use crate::analysis::AnalysisSettings;
 
@@ -32,8 +32,8 @@ pub struct MonitorSettings {
     pub flat_line_samples: u64,
     /// Where the shaft speed comes from.
     pub speed: SpeedMode,
-    /// The machine the velocity zones are judged for; `None`: no velocity analysis.
-    pub severity: Option<SeveritySettings>,
+    /// The detectors run besides the fault scores (the velocity zones, …).
+    pub detectors: DetectorSettings,
     /// The RMS trend published with the health stage.
     pub trend: TrendSettings,
 }

@@ -54,6 +54,9 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
     let outputs = check.outputs(&raw.outputs, &sensors);
     let fleet = check.fleet(&raw.fleet, outputs.as_ref().map(|o| o.state_dir.as_path()));
     let severity = check.severity(&raw.severity);
+    for (key, message) in raw.detectors.problems() {
+        check.problem(format!("detectors.{key}"), message);
+    }
     if let (Some((analysis, ..)), Some(twin)) = (&analysis, &twin) {
         if analysis.agreement.is_some() && twin.learned_model.is_none() {
             check.problem(
@@ -87,6 +90,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
             outputs,
             fleet,
             severity,
+            detectors: raw.detectors.clone(),
         }),
         _ => {
             if check.problems.is_empty() {

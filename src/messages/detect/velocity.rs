@@ -5,10 +5,8 @@
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
-use super::detect::{
-    stamped_by_fields, FlagRecord, FlagSpec, MetricKind, MetricSpec, MetricValue, Record,
-};
-use super::{ChannelId, FlagLevel, IsoZone};
+use super::{stamped_by_fields, FlagRecord, FlagSpec, MetricKind, MetricSpec, MetricValue, Record};
+use crate::messages::{ChannelId, FlagLevel, IsoZone};
 
 /// How status lines, the command line and alerts name the velocity zone flag (beside the
 /// fault kinds' names).
@@ -77,6 +75,10 @@ impl Record for VelocityMessage {
     fn metrics(&self, out: &mut dyn FnMut(usize, MetricValue<'_>)) {
         out(0, MetricValue::Text(self.zone.name()));
         out(1, MetricValue::Double(self.rms_mm_s));
+    }
+
+    fn status(&self) -> Option<(&'static str, String)> {
+        Some(("iso", format!("{}({:.2}mm/s)", self.zone, self.rms_mm_s)))
     }
 }
 

@@ -74,7 +74,7 @@ impl Bench {
         };
         MonitorSettings {
             // The sweep judges the envelope decision; the velocity zones are not part of it.
-            severity: None,
+            detectors: Default::default(),
             ..monitor_settings(&self.config, &sensor, 0, 1)
         }
     }
