@@ -35,7 +35,16 @@ import iceoryx2 as iox
 
 ALERT_VERSION = 1
 STATES = {1: "raised", 2: "escalated", 3: "relaxed", 4: "cleared", 5: "repeated"}
-FAULTS = {1: "outer_race", 2: "inner_race", 3: "ball", 4: "cage", 5: "iso_zone"}
+FAULTS = {
+    1: "outer_race",
+    2: "inner_race",
+    3: "ball",
+    4: "cage",
+    5: "iso_zone",
+    6: "unbalance",
+    7: "misalignment",
+    8: "looseness",
+}
 SEVERITIES = {0: "ok", 1: "watch", 2: "alarm"}
 
 

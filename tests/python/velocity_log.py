@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
-"""Reads the ISO velocity channels of bearingd MCAP logs with Python `mcap`'s strict reader.
+"""Reads the velocity detectors' channels of bearingd MCAP logs with Python `mcap`'s strict
+reader.
 
     velocity_log.py FILE.mcap...
 
 Prints one JSON object: `velocity` (every `/velocity/<sensor>/<axis>` message, in log order),
-`velocity_flags` (every `/velocity_flags/...` message) and `fault_flags` (every `/flags/...`),
-each message as decoded plus its `topic`; and `schemas` (topic -> schema name and encoding).
+`velocity_flags` (every `/velocity_flags/...` message), `machine` and `machine_flags` (the
+machine-fault detector's `/machine/...` and `/machine_flags/...`) and `fault_flags` (every
+`/flags/...`), each message as decoded plus its `topic`; and `schemas` (topic -> schema name and
+encoding).
 Exit status 1 when a file cannot be read strictly or a channel lacks its JSON Schema.
 """
 
@@ -19,8 +22,15 @@ def main():
     if len(sys.argv) < 2:
         print(__doc__, file=sys.stderr)
         return 2
-    out = {"velocity": [], "velocity_flags": [], "fault_flags": [], "schemas": {}}
-    families = {"/velocity/": "velocity", "/velocity_flags/": "velocity_flags", "/flags/": "fault_flags"}
+    families = {
+        "/velocity/": "velocity",
+        "/velocity_flags/": "velocity_flags",
+        "/machine/": "machine",
+        "/machine_flags/": "machine_flags",
+        "/flags/": "fault_flags",
+    }
+    out = {family: [] for family in families.values()}
+    out["schemas"] = {}
     for path in sys.argv[1:]:
         with open(path, "rb") as f:
             for schema, channel, message in make_reader(f).iter_messages(log_time_order=True):
