@@ -122,8 +122,10 @@ fn a_monitor_takes_hops_and_speed_changes_without_allocating() {
             max_shaft_hz: shaft * 1.5,
         },
         // The velocity severity (ISO zones) and its flag run every half window too.
+        // So do the machine-fault detector and its flags, every `averages` windows.
         detectors: bearingd::analysis::detectors::DetectorSettings {
             severity: Some(bearingd::analysis::iso::SeveritySettings::default()),
+            machine_faults: Some(Default::default()),
         },
         trend: bearingd::analysis::monitor::TrendSettings::default(),
     };

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 
 use super::detect::{ChannelContext, ChannelDetector, RecordFindings, RecordView};
 use super::iso::SeveritySettings;
+use super::machine::{MachineDetector, MachineFaultSettings};
 use super::velocity::VelocityDetector;
 
 /// Which detectors run, with their settings.
@@ -21,6 +22,8 @@ pub struct DetectorSettings {
     /// (older than this list, and always on in the daemon), so not a `[detectors]` section.
     #[serde(skip)]
     pub severity: Option<SeveritySettings>,
+    /// Unbalance, misalignment and looseness at shaft orders ([`super::machine`]).
+    pub machine_faults: Option<MachineFaultSettings>,
 }
 
 impl DetectorSettings {
@@ -29,6 +32,10 @@ impl DetectorSettings {
         let mut detectors: Vec<Box<dyn ChannelDetector>> = Vec::new();
         if let Some(severity) = self.severity {
             detectors.push(Box::new(VelocityDetector::new(severity, context)));
+        }
+        if let Some(machine) = self.machine_faults {
+            let severity = self.severity.unwrap_or_default();
+            detectors.push(Box::new(MachineDetector::new(machine, severity, context)));
         }
         detectors
     }
@@ -42,16 +49,35 @@ impl DetectorSettings {
 
     /// Every detector that judges whole records on, with its defaults: what `analyze` runs.
     pub fn for_records() -> DetectorSettings {
-        DetectorSettings::default()
+        DetectorSettings {
+            machine_faults: Some(MachineFaultSettings::default()),
+            ..DetectorSettings::default()
+        }
     }
 
     /// What each detector that is on says of a whole record (`analyze`).
-    pub fn analyze_record(&self, _record: &RecordView<'_>) -> Vec<RecordFindings> {
-        Vec::new()
+    pub fn analyze_record(&self, record: &RecordView<'_>) -> Vec<RecordFindings> {
+        let severity = self.severity.unwrap_or_default();
+        let mut found = Vec::new();
+        if let Some(machine) = &self.machine_faults {
+            found.push(machine.analyze_record(record, &severity));
+        }
+        found
     }
 
     /// Every problem of the settings as `(key under [detectors], what is wrong and the fix)`.
     pub fn problems(&self) -> Vec<(String, String)> {
-        Vec::new()
+        let mut problems = Vec::new();
+        let mut section = |name: &str, found: Vec<(&'static str, String)>| {
+            problems.extend(
+                found
+                    .into_iter()
+                    .map(|(key, problem)| (format!("{name}.{key}"), problem)),
+            )
+        };
+        if let Some(machine) = &self.machine_faults {
+            section("machine_faults", machine.problems());
+        }
+        problems
     }
 }

@@ -24,11 +24,22 @@
 //!   A and B for nothing (a healthy machine always has some 1×). Only findings at C or D are
 //!   reported.
 //!
+//! - **In the daemon** ([`MachineDetector`], `[detectors.machine_faults]`): the velocity power
+//!   per bin of every envelope window (its unwindowed spectrum, so no FFT of its own), summed
+//!   over `averages` windows, then judged as a record is; one flag per kind, raised at the
+//!   finding's zone C (watch) or D (alarm) with the fault flags' hysteresis and delays. It
+//!   judges nothing while the speed is unknown, or where a half order spans fewer than 4 bins
+//!   (the envelope window too short for the shaft rate).
+//!
 //! Sans-IO and allocation-free per call except the findings it returns.
 
-use super::iso::ZoneLimits;
+use super::detect::{ChannelContext, ChannelDetector, RecordFindings, RecordView, WindowView};
+use super::flags::FaultFlag;
+use super::iso::{band_hz, SeveritySettings, VelocityIntegrator, ZoneLimits};
 use crate::machine_fault::MachineFaultKind;
-use crate::messages::IsoZone;
+use crate::messages::detect::machine::{machine_flag_of, MachineFlagMessage, MachineMessage};
+use crate::messages::detect::FlagSpec;
+use crate::messages::{DetectorMessage, FlagLevel, IsoZone};
 use serde::{Deserialize, Serialize};
 
 /// The orders looked at: 0.5× to 10× in steps of a half.
@@ -36,6 +47,7 @@ pub const ORDERS: usize = 20;
 
 /// Where a machine-fault finding is reported, and how lines are found.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct MachineFaultSettings {
     /// Half-width of the search around each order, relative to its frequency.
     pub order_tolerance: f64,
@@ -166,7 +178,8 @@ pub fn machine_faults(
     let at = |order: f64| lines[((order / 0.5) as usize).saturating_sub(1)];
     let stands = |l: &OrderLine| l.over_floor >= settings.line_over_floor;
     let overall_ms = overall_mm_s * overall_mm_s;
-    let finding = |kind, parts: Vec<OrderLine>| {
+    // Allocates only for a finding it reports (the daemon calls this every few windows).
+    let finding = |kind, parts: &[OrderLine]| {
         let ms: f64 = parts.iter().map(|l| l.velocity_mm_s.powi(2)).sum();
         let share = if overall_ms > 0.0 {
             ms / overall_ms
@@ -175,12 +188,12 @@ pub fn machine_faults(
         };
         let velocity_mm_s = ms.sqrt();
         let zone = limits.zone(velocity_mm_s);
-        (share >= settings.min_share && zone >= IsoZone::C).then_some(MachineFinding {
+        (share >= settings.min_share && zone >= IsoZone::C).then(|| MachineFinding {
             kind,
             zone,
             velocity_mm_s,
             share,
-            orders: parts,
+            orders: parts.to_vec(),
         })
     };
     let integer_high = lines
@@ -192,19 +205,234 @@ pub fn machine_faults(
         .filter(|l| l.order.fract() == 0.5 && stands(l))
         .count();
     let found = if integer_high >= 3 && halves >= 2 {
-        let standing = lines.iter().copied().filter(stands).collect();
-        finding(MachineFaultKind::Looseness, standing)
+        let mut standing = [OrderLine {
+            order: 0.0,
+            velocity_mm_s: 0.0,
+            over_floor: 0.0,
+        }; ORDERS];
+        let mut n = 0;
+        for line in lines.iter().filter(|l| stands(l)) {
+            standing[n] = *line;
+            n += 1;
+        }
+        finding(MachineFaultKind::Looseness, &standing[..n])
     } else {
         let (v1, v2) = (at(1.0), at(2.0));
         if !stands(&v1) {
             None
         } else if v2.velocity_mm_s >= 0.5 * v1.velocity_mm_s {
-            finding(MachineFaultKind::Misalignment, vec![v1, v2, at(3.0)])
+            finding(MachineFaultKind::Misalignment, &[v1, v2, at(3.0)])
         } else {
-            finding(MachineFaultKind::Unbalance, vec![v1])
+            finding(MachineFaultKind::Unbalance, &[v1])
         }
     };
     found.into_iter().collect()
+}
+
+/// The fewest bins a half order must span for its lines to be told from their floor.
+const MIN_BINS_PER_HALF_ORDER: f64 = 4.0;
+
+/// Whether spectra of `bin_hz` resolve the half orders of `shaft_hz`.
+pub fn orders_resolved(bin_hz: f64, shaft_hz: f64) -> bool {
+    bin_hz > 0.0 && 0.5 * shaft_hz >= MIN_BINS_PER_HALF_ORDER * bin_hz
+}
+
+impl MachineFaultSettings {
+    /// What is wrong with the settings, as `(key, problem and fix)`.
+    pub fn problems(&self) -> Vec<(&'static str, String)> {
+        let mut problems = Vec::new();
+        if !(self.order_tolerance > 0.0 && self.order_tolerance <= 0.1) {
+            problems.push((
+                "order_tolerance",
+                format!(
+                    "{} is outside (0, 0.1]; use a small fraction, e.g. order_tolerance = 0.01",
+                    self.order_tolerance
+                ),
+            ));
+        }
+        if !(self.line_over_floor >= 1.0 && self.line_over_floor <= 100.0) {
+            problems.push((
+                "line_over_floor",
+                format!(
+                    "{} is outside [1, 100]; e.g. line_over_floor = 4.0",
+                    self.line_over_floor
+                ),
+            ));
+        }
+        if !(self.min_share > 0.0 && self.min_share <= 1.0) {
+            problems.push((
+                "min_share",
+                format!("{} is outside (0, 1]; e.g. min_share = 0.5", self.min_share),
+            ));
+        }
+        problems
+    }
+
+    /// The machine faults of a whole record (`analyze`): key `machine_faults`, a list of
+    /// findings (empty when none, or when the record has no velocity).
+    pub fn analyze_record(
+        &self,
+        record: &RecordView<'_>,
+        severity: &SeveritySettings,
+    ) -> RecordFindings {
+        let limits = ZoneLimits::of(severity.group, severity.foundation);
+        let found = match record.velocity {
+            Some(v) if orders_resolved(v.bin_hz, record.shaft_hz) => {
+                let lines = order_lines(&v.per_bin_mm2_s2, v.bin_hz, record.shaft_hz, self);
+                machine_faults(&lines, v.rms_mm_s, &limits, self)
+            }
+            _ => Vec::new(),
+        };
+        let lines = found
+            .iter()
+            .map(|f| {
+                format!(
+                    "machine fault: {} ({:.2} mm/s at shaft orders, zone {}, {:.0} % of the velocity)",
+                    f.kind.name(),
+                    f.velocity_mm_s,
+                    f.zone.name(),
+                    100.0 * f.share
+                )
+            })
+            .collect();
+        RecordFindings {
+            key: "machine_faults",
+            json: serde_json::to_value(&found).unwrap_or_default(),
+            lines,
+        }
+    }
+}
+
+/// The machine-fault detector of one channel.
+pub struct MachineDetector {
+    settings: MachineFaultSettings,
+    limits: ZoneLimits,
+    /// Reads the velocity power of the envelope's windows; `None` when the ISO band cannot be
+    /// taken from them (it starts below bin 2).
+    integrator: Option<VelocityIntegrator>,
+    /// Velocity power per bin, (m/s)², summed over `windows` windows.
+    power: Vec<f64>,
+    windows: usize,
+    averages: usize,
+    /// One flag per kind, in [`MachineFaultKind::ALL`] order.
+    flags: [FaultFlag; 3],
+}
+
+impl MachineDetector {
+    pub fn new(
+        settings: MachineFaultSettings,
+        severity: SeveritySettings,
+        context: &mut ChannelContext<'_>,
+    ) -> Self {
+        let limits = ZoneLimits::of(severity.group, severity.foundation);
+        let (lo, hi) = band_hz(context.shaft_hz * 60.0);
+        let band = (lo, hi.min(context.fs_hz / 2.0));
+        let integrator =
+            VelocityIntegrator::new(context.window, context.fs_hz, band, context.plans);
+        let integrator = integrator.takes_unwindowed().then_some(integrator);
+        let flag = FaultFlag::new(limits.flag_settings(context.flags));
+        MachineDetector {
+            settings,
+            limits,
+            power: vec![
+                0.0;
+                if integrator.is_some() {
+                    context.window / 2 + 1
+                } else {
+                    0
+                }
+            ],
+            integrator,
+            windows: 0,
+            averages: context.averages.max(1),
+            flags: [flag.clone(), flag.clone(), flag],
+        }
+    }
+
+    /// Judges the summed windows: flag changes, then the reading.
+    fn judge(
+        &mut self,
+        end_sample: u64,
+        shaft_hz: f64,
+        bin_hz: f64,
+        out: &mut dyn FnMut(DetectorMessage),
+    ) {
+        let scale = 1e6 / self.windows as f64; // (m/s)² → (mm/s)², averaged
+        self.power.iter_mut().for_each(|p| *p *= scale);
+        let overall_mm_s = self.power.iter().sum::<f64>().sqrt();
+        let lines = order_lines(&self.power, bin_hz, shaft_hz, &self.settings);
+        let finding = machine_faults(&lines, overall_mm_s, &self.limits, &self.settings)
+            .into_iter()
+            .next();
+        for (kind, flag) in MachineFaultKind::ALL.iter().zip(&mut self.flags) {
+            let velocity_mm_s = finding
+                .as_ref()
+                .filter(|f| f.kind == *kind)
+                .map_or(0.0, |f| f.velocity_mm_s);
+            if let Some(change) = flag.update(velocity_mm_s, end_sample) {
+                out(MachineFlagMessage {
+                    channel: Default::default(),
+                    end_sample: change.at_sample,
+                    kind: *kind,
+                    from: change.from,
+                    to: change.to,
+                    velocity_mm_s,
+                    watch_mm_s: self.limits.bc_mm_s,
+                    alarm_mm_s: self.limits.cd_mm_s,
+                }
+                .into());
+            }
+        }
+        let at = |order: usize| lines[2 * order - 1].velocity_mm_s;
+        out(MachineMessage {
+            channel: Default::default(),
+            end_sample,
+            shaft_hz,
+            overall_mm_s,
+            orders_mm_s: [at(1), at(2), at(3)],
+            fault: finding.as_ref().map(|f| f.kind),
+            fault_mm_s: finding.as_ref().map_or(0.0, |f| f.velocity_mm_s),
+            zone: finding.as_ref().map_or(IsoZone::A, |f| f.zone),
+            windows_averaged: self.windows,
+        }
+        .into());
+        self.power.iter_mut().for_each(|p| *p = 0.0);
+        self.windows = 0;
+    }
+}
+
+impl ChannelDetector for MachineDetector {
+    fn restart_at(&mut self, _first_sample: u64) {
+        self.power.iter_mut().for_each(|p| *p = 0.0);
+        self.windows = 0;
+    }
+
+    fn on_samples(&mut self, _samples: &[f32], _out: &mut dyn FnMut(DetectorMessage)) {}
+
+    fn on_window(&mut self, window: &WindowView<'_>, out: &mut dyn FnMut(DetectorMessage)) {
+        let (Some(integrator), Some(shaft_hz)) = (&self.integrator, window.shaft_hz) else {
+            return;
+        };
+        let bin_hz = integrator.bin_hz();
+        if !orders_resolved(bin_hz, shaft_hz) {
+            return;
+        }
+        let ms = integrator.mean_square_of_unwindowed(window.spectrum, Some(&mut self.power));
+        if !ms.is_finite() {
+            // A spectrum of another length: nothing was added.
+            return;
+        }
+        self.windows += 1;
+        if self.windows >= self.averages {
+            self.judge(window.end_sample, shaft_hz, bin_hz, out);
+        }
+    }
+
+    fn flag_levels(&self, out: &mut dyn FnMut(&'static FlagSpec, FlagLevel)) {
+        for (kind, flag) in MachineFaultKind::ALL.iter().zip(&self.flags) {
+            out(machine_flag_of(*kind), flag.level());
+        }
+    }
 }
 
 #[cfg(test)]

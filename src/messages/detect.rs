@@ -32,6 +32,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{ChannelId, FlagLevel, PipelineMessage};
 
+pub mod machine;
 pub mod velocity;
 
 /// A flag of a detector: how alerts, status lines and the command line name it, and its code in
@@ -380,6 +381,7 @@ macro_rules! detectors {
 
 detectors! {
     Velocity { reading: super::VelocityMessage, flag: super::VelocityFlagMessage },
+    Machine { reading: machine::MachineMessage, flag: machine::MachineFlagMessage },
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ mod hostile_files;
 mod hostile_logs;
 mod kinematics;
 mod learned;
+mod machine;
 mod monitor;
 mod replay;
 mod rolling_element;

@@ -137,6 +137,7 @@ fn describe(event: MonitorEvent, events: &mut Vec<String>) {
         MonitorEvent::Detector(DetectorMessage::Velocity(Emitted::Flag(f))) => events.push(
             format!("velocity flag {:?}->{:?} at {}", f.from, f.to, f.end_sample),
         ),
+        MonitorEvent::Detector(other) => events.push(format!("{other:?}")),
         MonitorEvent::Window(_) => {}
     }
 }

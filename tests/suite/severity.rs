@@ -131,7 +131,7 @@ fn issue16_a_wav_has_no_velocity_and_says_why() {
 }
 
 /// What `tests/python/velocity_log.py` (Python `mcap`, strict reader) finds in the logs.
-fn velocity_log(py: &Path, files: &[std::path::PathBuf]) -> Value {
+pub(crate) fn velocity_log(py: &Path, files: &[std::path::PathBuf]) -> Value {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/velocity_log.py");
     let out = Command::new(py)
         .arg(script)
@@ -147,10 +147,16 @@ fn velocity_log(py: &Path, files: &[std::path::PathBuf]) -> Value {
 }
 
 /// A config of the simulated node with `imbalance_g` of once-per-revolution tone and no
-/// bearing fault, logging under `dir`.
-fn imbalance_config(dir: &Path, imbalance_g: f64) -> std::path::PathBuf {
+/// bearing fault, logging under `dir`, its iceoryx2 root named by `iox_tag` (one per test),
+/// with `extra` (TOML) at its end.
+pub(crate) fn imbalance_config(
+    dir: &Path,
+    imbalance_g: f64,
+    iox_tag: &str,
+    extra: &str,
+) -> std::path::PathBuf {
     // Outside /tmp (the config refuses it there), short enough for iceoryx2's socket paths.
-    let iox = iox_root(env!("CARGO_TARGET_TMPDIR"), "is");
+    let iox = iox_root(env!("CARGO_TARGET_TMPDIR"), iox_tag);
     let text = format!(
         r#"[[sensors]]
 id = "motor-de"
@@ -172,6 +178,7 @@ foundation = "rigid"
 state_dir = "{state}"
 mcap_dir = "{mcap}"
 iceoryx2_root = "{iox}"
+{extra}
 "#,
         state = dir.join("state").display(),
         mcap = dir.join("mcap").display(),
@@ -182,7 +189,7 @@ iceoryx2_root = "{iox}"
     path
 }
 
-fn run_ok(args: &[&str]) -> String {
+pub(crate) fn run_ok(args: &[&str]) -> String {
     let out = bearingd(args);
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(
@@ -217,7 +224,7 @@ fn issue16_the_daemon_logs_velocity_and_raises_the_zone_flag_after_its_delay() {
     let dir = scratch_dir("severity-daemon");
     // 0.1 g at the shaft rate (29.53 Hz): 3.74 mm/s, zone C of group 2 on a rigid foundation
     // (C from 2.8, D from 4.5 mm/s); the 0.05 g of noise adds 0.2 mm/s in quadrature.
-    let config = imbalance_config(&dir, 0.1);
+    let config = imbalance_config(&dir, 0.1, "is", "");
     let stdout = run_ok(&[
         "run",
         "--config",
