@@ -254,7 +254,7 @@ impl MachineFaultSettings {
             problems.push((
                 "line_over_floor",
                 format!(
-                    "{} is outside [1, 100]; e.g. line_over_floor = 4.0",
+                    "{} is outside [1, 100]; set it in that range, e.g. line_over_floor = 4.0",
                     self.line_over_floor
                 ),
             ));
@@ -262,7 +262,10 @@ impl MachineFaultSettings {
         if !(self.min_share > 0.0 && self.min_share <= 1.0) {
             problems.push((
                 "min_share",
-                format!("{} is outside (0, 1]; e.g. min_share = 0.5", self.min_share),
+                format!(
+                    "{} is outside (0, 1]; set a share above 0 and at most 1, e.g. min_share = 0.5",
+                    self.min_share
+                ),
             ));
         }
         problems
