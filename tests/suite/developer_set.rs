@@ -8,6 +8,7 @@
 //! - no record names a machine fault (unbalance, misalignment, looseness): the rigs' shafts
 //!   are balanced and aligned (issue 31 item 2).
 
+use bearingd::analysis::machine::orders_resolved;
 use bearingd::analysis::record::RecordAnalyzer;
 use bearingd::offline::{analyze, AnalyzeOutcome, AnalyzeRequest};
 use bearingd::recording::ReadOptions;
@@ -35,7 +36,7 @@ fn machine_faults(outcome: &AnalyzeOutcome) -> (Option<String>, bool) {
         .report
         .velocity
         .as_ref()
-        .is_some_and(|v| v.bin_hz * 8.0 <= outcome.report.rpm / 60.0);
+        .is_some_and(|v| orders_resolved(v.bin_hz, outcome.report.rpm / 60.0));
     (named, judged)
 }
 
