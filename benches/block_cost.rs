@@ -4,9 +4,14 @@
 //! from the start of `handle` to the moment the flag change comes out (when the daemon hands
 //! it to the alert publisher).
 //!
-//! The config is the alert-latency bench's chattering one (every sensor's outer race faulty,
-//! one window per average, thresholds at the middle of the scores), so that many windows
-//! decide an alert. The inputs are seeded: two builds on one machine compare fairly.
+//! The config is the alert-latency bench's (every sensor's outer race faulty, one window per
+//! average, thresholds at the middle of the scores). Since the flags follow the verdicts of band
+//! selections over a whole evidence horizon (issue 30 item 4), a flag changes only in the block
+//! that takes a selection's result, once per `band_period_s` and channel: few blocks decide
+//! an alert. This bench runs faster than real time, so such a block also waits for the band
+//! worker to finish the selection (tens of ms), which the daemon at real time does not: read
+//! the alert rows as an upper bound, and the window row as the per-window analysis. The inputs
+//! are seeded: two builds on one machine compare fairly.
 //!
 //! Run: `cargo bench --bench block_cost` (`BENCH_SENSORS`, default 16; `BENCH_SECONDS` of
 //! signal, default 60).

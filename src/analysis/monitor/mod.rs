@@ -51,6 +51,8 @@ mod events;
 mod selection;
 mod sensor;
 mod settings;
+#[cfg(test)]
+mod tests;
 
 pub use events::{MonitorEvent, SensorCondition, WindowReport};
 pub use settings::{MonitorSettings, TrendSettings};
@@ -64,7 +66,7 @@ use super::envelope::{window_samples, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::FaultFlag;
 use super::health::{Baseline, HealthTracker, CONFIRM_WINDOWS};
-use super::indicators::Indicators;
+use super::indicators::WindowIndicators;
 use super::speed::SpeedMode;
 use super::Band;
 use crate::bearing::FaultFrequencies;
@@ -83,6 +85,8 @@ pub struct ChannelMonitor {
     /// A speed change given for a sample not reached yet: (sample, shaft rate).
     pending_speed: Option<(u64, Option<f64>)>,
     rolling: RollingEnvelope,
+    /// The time-domain indicators of each window, from segments shared by overlapping windows.
+    indicators: WindowIndicators,
     scorer: FaultScorer,
     flags: [FaultFlag; 4],
     health: HealthTracker,
@@ -172,6 +176,7 @@ impl ChannelMonitor {
         });
         ChannelMonitor {
             detectors,
+            indicators: WindowIndicators::new(window, hop),
             rolling: RollingEnvelope::new(
                 settings.fs_hz,
                 window,
@@ -385,6 +390,7 @@ impl ChannelMonitor {
                 });
             }
             self.rolling.restart_at(first_sample);
+            self.indicators.restart();
             for detector in &mut self.detectors {
                 detector.restart_at(first_sample);
             }
@@ -403,14 +409,19 @@ impl ChannelMonitor {
             for (s, &c) in scratch.iter_mut().zip(chunk) {
                 *s = (f64::from(c) * scale_g_per_count) as f32;
             }
-            self.push_samples(&scratch[..chunk.len()], on_event);
+            self.push_samples(&scratch[..chunk.len()], chunk, on_event);
             self.scratch = scratch;
         }
     }
 
-    /// Cuts `samples` at the scheduled band selections, so that a selection happens at the same
-    /// sample whatever the block sizes.
-    fn push_samples(&mut self, mut samples: &[f32], on_event: &mut impl FnMut(MonitorEvent)) {
+    /// Cuts `samples` (in g) and their `counts` at the scheduled band selections, so that a
+    /// selection happens at the same sample whatever the block sizes.
+    fn push_samples(
+        &mut self,
+        mut samples: &[f32],
+        mut counts: &[i16],
+        on_event: &mut impl FnMut(MonitorEvent),
+    ) {
         while !samples.is_empty() {
             if self.band_result_at.is_some_and(|at| at <= self.next_sample) {
                 self.use_band_result(on_event);
@@ -433,8 +444,9 @@ impl ChannelMonitor {
             if let Some(at) = self.band_result_at {
                 take = take.min((at - self.next_sample) as usize);
             }
-            self.analyse(&samples[..take], on_event);
+            self.analyse(&samples[..take], &counts[..take], on_event);
             samples = &samples[take..];
+            counts = &counts[take..];
             if self.next_sample >= self.next_band_selection {
                 let enough = self.history_filled >= self.min_evidence_samples;
                 if enough {
@@ -451,15 +463,23 @@ impl ChannelMonitor {
         }
     }
 
-    fn analyse(&mut self, samples: &[f32], on_event: &mut impl FnMut(MonitorEvent)) {
-        // Keep the history for band selection.
+    /// `samples` are `counts` in g.
+    fn analyse(
+        &mut self,
+        samples: &[f32],
+        counts: &[i16],
+        on_event: &mut impl FnMut(MonitorEvent),
+    ) {
+        // Keep the history for band selection, as counts (a quarter of the memory of f64).
         let n = self.history.len();
-        let per_count = 1.0 / self.history_scale;
-        for &x in samples {
-            // Exact: x is a count times the scale, rounded to f32 (relative error 6e-8).
-            self.history[self.history_at] = (f64::from(x) * per_count).round() as i16;
-            self.history_at = (self.history_at + 1) % n;
-        }
+        // Only the newest `n` counts can stay; copied in at most two runs around the ring.
+        let kept = &counts[counts.len().saturating_sub(n)..];
+        self.history_at = (self.history_at + counts.len() - kept.len()) % n;
+        let first_run = kept.len().min(n - self.history_at);
+        let (to_end, from_start) = kept.split_at(first_run);
+        self.history[self.history_at..self.history_at + first_run].copy_from_slice(to_end);
+        self.history[..from_start.len()].copy_from_slice(from_start);
+        self.history_at = (self.history_at + kept.len()) % n;
         self.history_filled = (self.history_filled + samples.len()).min(n);
         self.next_sample += samples.len() as u64;
 
@@ -469,6 +489,7 @@ impl ChannelMonitor {
 
         let ChannelMonitor {
             rolling,
+            indicators: window_indicators,
             detectors,
             scorer,
             health,
@@ -505,8 +526,7 @@ impl ChannelMonitor {
             for detector in detectors.iter_mut() {
                 detector.on_window(&window, &mut |m| on_event(MonitorEvent::Detector(m)));
             }
-            let indicators =
-                Indicators::of_slices(&[update.window_samples.0, update.window_samples.1]);
+            let indicators = window_indicators.of_window(update.end_sample, update.window_samples);
             if let Some(change) =
                 health.update(indicators.kurtosis, indicators.rms, update.end_sample)
             {

@@ -10,7 +10,7 @@ use crate::messages::FaultKind;
 
 impl ChannelMonitor {
     /// The history's filled part as counts, oldest first.
-    fn history_counts(&self) -> Vec<i16> {
+    pub(super) fn history_counts(&self) -> Vec<i16> {
         let n = self.history.len();
         let filled = self.history_filled.min(n);
         (0..filled)

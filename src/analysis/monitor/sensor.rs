@@ -47,6 +47,44 @@ impl SensorWatch {
         counts: &[i16],
         on_event: &mut impl FnMut(MonitorEvent),
     ) {
+        if !self.skim(at, counts) {
+            self.check_each(at, counts, on_event);
+        }
+    }
+
+    /// The usual case, without a branch per sample: neither condition is on, no count reaches
+    /// full scale and no run of equal counts reaches the flat-line length, so nothing can start
+    /// or end and only the current run has to be followed. Returns false, having changed
+    /// nothing, when the counts need [`Self::check_each`].
+    fn skim(&mut self, at: u64, counts: &[i16]) -> bool {
+        let (Some(&last), Some(previous)) = (counts.last(), self.last_count) else {
+            return false;
+        };
+        let loudest = counts.iter().map(|c| c.unsigned_abs()).max().unwrap_or(0);
+        if self.clipping
+            || self.flat
+            || i32::from(loudest) >= self.clip_count
+            || counts.len() as u64 >= self.flat_line_samples
+        {
+            return false;
+        }
+        // Shorter than a flat line, the block can only hold one if the run it continues
+        // (from `flat_since`) or the run it ends with reaches the length.
+        let first_change = counts.iter().position(|&c| i32::from(c) != previous);
+        let last_run_from = counts.windows(2).rposition(|w| w[0] != w[1]).map(|i| i + 1);
+        let continued_to = at + first_change.unwrap_or(counts.len()) as u64;
+        if continued_to.saturating_sub(self.flat_since) >= self.flat_line_samples {
+            return false;
+        }
+        if first_change.is_some() {
+            self.flat_since = at + last_run_from.unwrap_or(0).max(first_change.unwrap_or(0)) as u64;
+            self.last_count = Some(i32::from(last));
+        }
+        true
+    }
+
+    /// Sample by sample: every start and end at its exact sample.
+    fn check_each(&mut self, at: u64, counts: &[i16], on_event: &mut impl FnMut(MonitorEvent)) {
         for (i, &c) in counts.iter().enumerate() {
             let sample = at + i as u64;
             let c = i32::from(c);
@@ -166,6 +204,63 @@ mod tests {
         for block in [1, 7, 64, 99, 1_000] {
             assert_eq!(events(&counts, block), whole, "blocks of {block}");
         }
+    }
+
+    /// Blocks shorter than a flat line go through [`SensorWatch::skim`]: the events and the
+    /// state they leave must be those of the sample-by-sample check.
+    #[test]
+    fn skimming_a_block_changes_nothing_the_sample_by_sample_check_would_not() {
+        // Runs of every length around the flat-line length (100), clipped counts, and noise.
+        let mut counts = Vec::new();
+        let mut state = 12_345u32;
+        for run in (1..=130).chain([99, 100, 101, 250]) {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            let value = (state >> 16) as i16 % 50;
+            counts.extend(std::iter::repeat_n(value, run));
+            if run % 37 == 0 {
+                counts.push(i16::MIN);
+            }
+        }
+        let sensor_event = |e: MonitorEvent| match e {
+            MonitorEvent::Sensor {
+                condition,
+                active,
+                at_sample,
+            } => (condition, active, at_sample),
+            _ => unreachable!("the sensor watch reports sensor events only"),
+        };
+        let mut exact = SensorWatch::new(32_767, 100);
+        let mut want = Vec::new();
+        exact.check_each(0, &counts, &mut |e| want.push(sensor_event(e)));
+        for block in [1, 2, 3, 50, 99] {
+            let mut watch = SensorWatch::new(32_767, 100);
+            let mut seen = Vec::new();
+            for (k, chunk) in counts.chunks(block).enumerate() {
+                watch.check((k * block) as u64, chunk, &mut |e| {
+                    seen.push(sensor_event(e))
+                });
+            }
+            assert_eq!(seen, want, "blocks of {block}");
+            assert_eq!(
+                (
+                    watch.flat_since,
+                    watch.last_count,
+                    watch.flat,
+                    watch.clipping
+                ),
+                (
+                    exact.flat_since,
+                    exact.last_count,
+                    exact.flat,
+                    exact.clipping
+                ),
+                "blocks of {block}"
+            );
+        }
+        assert!(
+            want.len() > 10,
+            "the sequence must start and end both conditions: {want:?}"
+        );
     }
 
     #[test]
