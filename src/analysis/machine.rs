@@ -272,35 +272,54 @@ impl MachineFaultSettings {
     }
 
     /// The machine faults of a whole record (`analyze`): key `machine_faults`, a list of
-    /// findings (empty when none, or when the record has no velocity).
+    /// findings (empty when none), or null with the reason in the text when the record cannot
+    /// be judged: no velocity (no scale to g), or windows too short to resolve half orders.
     pub fn analyze_record(
         &self,
         record: &RecordView<'_>,
         severity: &SeveritySettings,
     ) -> RecordFindings {
         let limits = ZoneLimits::of(severity.group, severity.foundation);
-        let found = match record.velocity {
-            Some(v) if orders_resolved(v.bin_hz, record.shaft_hz) => {
+        let judged = match record.velocity {
+            None => Err("the record has no velocity (a WAV file holds no scale to g; \
+                 export the record in g, as CSV or .mat)"
+                .to_string()),
+            Some(v) if !orders_resolved(v.bin_hz, record.shaft_hz) => Err(format!(
+                "a half order ({:.2} Hz) spans {:.1} bins of {:.2} Hz, needs {MIN_BINS_PER_HALF_ORDER}: \
+                 the record is too short for windows that resolve it",
+                0.5 * record.shaft_hz,
+                0.5 * record.shaft_hz / v.bin_hz.max(f64::MIN_POSITIVE),
+                v.bin_hz
+            )),
+            Some(v) => {
                 let lines = order_lines(&v.per_bin_mm2_s2, v.bin_hz, record.shaft_hz, self);
-                machine_faults(&lines, v.rms_mm_s, &limits, self)
+                Ok(machine_faults(&lines, v.rms_mm_s, &limits, self))
             }
-            _ => Vec::new(),
         };
-        let lines = found
-            .iter()
-            .map(|f| {
-                format!(
-                    "machine fault: {} ({:.2} mm/s at shaft orders, zone {}, {:.0} % of the velocity)",
-                    f.kind.name(),
-                    f.velocity_mm_s,
-                    f.zone.name(),
-                    100.0 * f.share
-                )
-            })
-            .collect();
+        let (json, lines) = match judged {
+            Ok(found) => (
+                serde_json::to_value(&found).unwrap_or_default(),
+                found
+                    .iter()
+                    .map(|f| {
+                        format!(
+                            "machine fault: {} ({:.2} mm/s at shaft orders, zone {}, {:.0} % of the velocity)",
+                            f.kind.name(),
+                            f.velocity_mm_s,
+                            f.zone.name(),
+                            100.0 * f.share
+                        )
+                    })
+                    .collect(),
+            ),
+            Err(why) => (
+                serde_json::Value::Null,
+                vec![format!("machine faults: not judged, {why}")],
+            ),
+        };
         RecordFindings {
             key: "machine_faults",
-            json: serde_json::to_value(&found).unwrap_or_default(),
+            json,
             lines,
         }
     }

@@ -360,3 +360,54 @@ fn analyze_names_each_simulated_machine_fault_in_its_json_and_none_without() {
         }
     }
 }
+
+/// A record too short to resolve half orders is not judged: `machine_faults` is null (not an
+/// empty list, which would say "none found") and the text says why.
+#[test]
+fn analyze_says_a_record_too_short_for_half_orders_is_not_judged() {
+    let dir = bearingd_testdata::scratch_dir("machine-short");
+    let csv = dir.join("short.csv");
+    let csv = csv.to_str().unwrap();
+    let run = |args: &[&str]| {
+        let out = bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd"), args);
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    };
+    run(&[
+        "simulate",
+        "--fault",
+        "none",
+        "--fs",
+        "25600",
+        "--duration",
+        "0.2s",
+        "--out",
+        csv,
+    ]);
+    let analyze = [
+        "analyze",
+        csv,
+        "--fs",
+        "25600",
+        "--rpm",
+        "1772",
+        "--bearing",
+        "skf-6205-2rs",
+    ];
+    let json: serde_json::Value =
+        serde_json::from_str(&run(&[&analyze[..], &["--format", "json"]].concat())).expect("JSON");
+    assert!(
+        json["machine_faults"].is_null(),
+        "{}",
+        json["machine_faults"]
+    );
+    let text = run(&analyze);
+    assert!(
+        text.contains("machine faults: not judged, a half order (14.77 Hz) spans"),
+        "{text}"
+    );
+}
