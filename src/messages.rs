@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 use std::fmt;
 
 pub mod detect;
+mod stamp;
 
 pub use detect::velocity::{
     VelocityFlagMessage, VelocityMessage, ISO_ZONE_FLAG, VELOCITY_FLAG_NAME,
@@ -455,7 +456,9 @@ pub struct IngestMessage {
     pub handoff_dropped: u64,
 }
 
-/// Everything the pipeline emits, in the order it emits it.
+/// Everything the pipeline emits, in the order it emits it. Where and when a message is (its
+/// channel, its end sample) is asked with [`PipelineMessage::channel`] and
+/// [`PipelineMessage::end_sample`] (`messages/stamp.rs`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub enum PipelineMessage {
     Raw(RawBlock),
