@@ -250,24 +250,20 @@ impl McapSink {
         self.logger.as_ref().map(McapLogger::stats)
     }
 
+    /// The message's log time: the time of its sample at its sensor's rate. A raw block is
+    /// logged at its first sample (a replay of a log without metadata takes its time base from
+    /// that), every other message at its end sample; a source's counters, which have no sample,
+    /// at the newest log time.
     fn log_time(&self, message: &PipelineMessage) -> u64 {
-        let at = |sensor: &str, sample: u64| {
-            let fs = self.rates.get(sensor).copied().unwrap_or(1.0);
-            self.origin_ns + (sample as f64 / fs * 1e9) as u64
+        let sample = match message {
+            PipelineMessage::Raw(m) => Some(m.first_sample),
+            _ => message.end_sample(),
         };
-        match message {
-            PipelineMessage::Raw(m) => at(&m.channel.sensor, m.first_sample),
-            PipelineMessage::Spectrum(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Indicators(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Twin(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Hw(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Trend(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Flag(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Health(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Speed(m) => at(&m.channel.sensor, m.end_sample),
-            PipelineMessage::Detector(m) => at(&m.channel().sensor, m.end_sample()),
-            PipelineMessage::Ingest(_) => self.last_ns,
-        }
+        let (Some(channel), Some(sample)) = (message.channel(), sample) else {
+            return self.last_ns;
+        };
+        let fs = self.rates.get(&channel.sensor).copied().unwrap_or(1.0);
+        self.origin_ns + (sample as f64 / fs * 1e9) as u64
     }
 
     /// Says a retention pass that deleted files (or skipped names that are not its own files),
