@@ -103,75 +103,56 @@ impl FleetSink {
     }
 
     fn observation(&self, message: &PipelineMessage) -> Option<Observation> {
-        let (channel, sample, what) = match message {
-            PipelineMessage::Indicators(m) => (
-                &m.channel,
-                m.end_sample,
-                Observed::Window {
-                    rpm: m.rpm.is_finite().then_some(m.rpm),
-                    rms_g: m.rms,
-                    peak_g: m.peak,
-                    crest: m.crest,
-                    kurtosis: m.kurtosis,
-                    scores: [
-                        m.score_outer_race,
-                        m.score_inner_race,
-                        m.score_ball,
-                        m.score_cage,
-                    ],
-                },
-            ),
-            PipelineMessage::Health(m) => {
-                let what = match (m.kind, m.stage) {
-                    (HealthKind::Stage, Some(stage)) => Observed::Stage(stage),
-                    (HealthKind::Lost, _) => Observed::SensorLost(true),
-                    (HealthKind::Back, _) => Observed::SensorLost(false),
-                    _ => return None,
-                };
-                (&m.channel, m.end_sample, what)
-            }
-            PipelineMessage::Twin(m) => (
-                &m.channel,
-                m.end_sample,
-                Observed::Twin {
-                    hypothesis: m.hypothesis,
-                    error: m.error,
-                    margin: m.margin,
-                    errors: [m.error_outer_race, m.error_inner_race, m.error_ball],
-                    residual_energy_ratio: m.residual_energy_ratio,
-                    residual_peak_hz: m.residual_peak_hz,
-                },
-            ),
-            PipelineMessage::Hw(m) => (
-                &m.channel,
-                m.end_sample,
-                Observed::Hw {
-                    accuracy: m.accuracy_simulation,
-                    residual_drift_sigma: m.residual_drift_sigma,
-                    parameter_drift: m.parameter_drift,
-                },
-            ),
-            PipelineMessage::Trend(m) => (
-                &m.channel,
-                m.end_sample,
-                Observed::Trend {
-                    time_to_limit_s: m.time_to_threshold_s,
-                    earliest_s: m.earliest_s,
-                },
-            ),
-            PipelineMessage::Speed(m) => (&m.channel, m.end_sample, Observed::Speed(m.rpm)),
+        let what = match message {
+            PipelineMessage::Indicators(m) => Observed::Window {
+                rpm: m.rpm.is_finite().then_some(m.rpm),
+                rms_g: m.rms,
+                peak_g: m.peak,
+                crest: m.crest,
+                kurtosis: m.kurtosis,
+                scores: [
+                    m.score_outer_race,
+                    m.score_inner_race,
+                    m.score_ball,
+                    m.score_cage,
+                ],
+            },
+            PipelineMessage::Health(m) => match (m.kind, m.stage) {
+                (HealthKind::Stage, Some(stage)) => Observed::Stage(stage),
+                (HealthKind::Lost, _) => Observed::SensorLost(true),
+                (HealthKind::Back, _) => Observed::SensorLost(false),
+                _ => return None,
+            },
+            PipelineMessage::Twin(m) => Observed::Twin {
+                hypothesis: m.hypothesis,
+                error: m.error,
+                margin: m.margin,
+                errors: [m.error_outer_race, m.error_inner_race, m.error_ball],
+                residual_energy_ratio: m.residual_energy_ratio,
+                residual_peak_hz: m.residual_peak_hz,
+            },
+            PipelineMessage::Hw(m) => Observed::Hw {
+                accuracy: m.accuracy_simulation,
+                residual_drift_sigma: m.residual_drift_sigma,
+                parameter_drift: m.parameter_drift,
+            },
+            PipelineMessage::Trend(m) => Observed::Trend {
+                time_to_limit_s: m.time_to_threshold_s,
+                earliest_s: m.earliest_s,
+            },
+            PipelineMessage::Speed(m) => Observed::Speed(m.rpm),
             // Every detector reading: its metrics go at the publish period, an urgent one (a new
             // ISO zone) at once. A detector's flag change has no metrics: its readings' follow
             // it (the zone metric changes first, and at once).
-            PipelineMessage::Detector(m) => {
-                (m.channel(), m.end_sample(), Observed::of_detector(m)?)
-            }
+            PipelineMessage::Detector(m) => Observed::of_detector(m)?,
             // A fault flag goes with its alert, which comes right after it.
             PipelineMessage::Raw(_)
             | PipelineMessage::Spectrum(_)
             | PipelineMessage::Ingest(_)
             | PipelineMessage::Flag(_) => return None,
         };
+        // Every message observed above has both.
+        let (channel, sample) = (message.channel()?, message.end_sample()?);
         Some(Observation {
             device: *self.channels.get(channel)?,
             at_ms: self.at_ms(channel, sample),
