@@ -271,18 +271,19 @@ mod tests {
 
     #[test]
     fn a_sources_counters_have_neither_channel_nor_sample() {
+        // A node's shared memory: one source for both of its axes.
         let ingest = PipelineMessage::Ingest(IngestMessage {
-            source: "can-vcan0".into(),
-            frames: 1,
-            samples: 2,
-            gaps: 0,
-            missing_samples: 0,
+            source: "shm-node1".into(),
+            frames: 400,
+            samples: 102_400,
+            gaps: 1,
+            missing_samples: 256,
             malformed: 0,
             restarts: 0,
             dropped_blocks: 0,
-            speed_frames: 0,
+            speed_frames: 10,
             sensor_lost: 0,
-            handoff_dropped: 0,
+            handoff_dropped: 1,
         });
         assert_eq!(ingest.channel(), None);
         assert_eq!(ingest.end_sample(), None);
