@@ -647,3 +647,6 @@ async fn report_status(
         events(DaemonEvent::Status(board));
     }
 }
+
+#[cfg(test)]
+mod tests;
