@@ -5,6 +5,7 @@ use super::*;
 use crate::config::parse;
 use crate::daemon::events::ignore_events;
 use std::sync::Mutex;
+use std::time::Instant;
 
 /// A directory of its own under the system's temporary directory, removed when dropped.
 struct Scratch(PathBuf);
@@ -102,6 +103,130 @@ fn entries(dir: &Path) -> Vec<String> {
 fn set_mode(dir: &Path, mode: u32) {
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(dir, std::fs::Permissions::from_mode(mode)).unwrap();
+}
+
+#[test]
+fn a_run_of_one_simulated_sensor_stops_at_its_duration_and_sums_up_its_channel() {
+    let scratch = Scratch::new("duration");
+    let config = sim_config(scratch.path());
+    let mcap_dir = config.outputs.mcap_dir.clone();
+    let (events, said) = kept_events();
+    let options = RunOptions {
+        duration_s: Some(2.0),
+        realtime: false,
+        status_lines: false,
+    };
+    // The shutdown never comes: only the duration can end the run.
+    let summary = run_blocking(config, options, events, std::future::pending()).unwrap();
+
+    assert_eq!(summary.channels.len(), 1, "{:?}", summary.channels);
+    let channel = &summary.channels[0];
+    assert_eq!(channel.channel.to_string(), "unit/radial");
+    // Whole blocks of 0.1 s: the duration, and less than one block more.
+    assert!(
+        (2.0..2.1).contains(&channel.seconds),
+        "sample time {} s for a 2 s run",
+        channel.seconds
+    );
+    assert!(
+        channel.samples >= 2 * 25_600 && channel.samples < 2 * 25_600 + 2_560,
+        "{} samples",
+        channel.samples
+    );
+    assert_eq!((channel.gaps, channel.missing_samples), (0, 0));
+    assert!(!channel.sensor_lost);
+    assert!(summary.messages > 0, "nothing reached the sinks");
+    assert_eq!(summary.alerts_failed, 0);
+    assert_eq!(summary.alerts_published, 0, "no alert service in this plan");
+    assert!(
+        summary.flags.is_empty(),
+        "a healthy bearing: {:?}",
+        summary.flags
+    );
+
+    // The log it wrote.
+    let logs: Vec<String> = entries(&mcap_dir)
+        .into_iter()
+        .filter(|name| name.ends_with(".mcap"))
+        .collect();
+    assert_eq!(logs.len(), 1, "{:?}", entries(&mcap_dir));
+    let said = said.lock().unwrap().join("\n");
+    assert!(
+        said.contains("NoState"),
+        "a first start has no state: {said}"
+    );
+    assert!(said.contains("LoggingTo"), "{said}");
+}
+
+#[test]
+fn a_restart_in_the_same_directories_starts_from_the_state_saved_at_the_stop() {
+    let scratch = Scratch::new("restart");
+    let config = sim_config(scratch.path());
+    let (mcap_dir, state_dir) = (
+        config.outputs.mcap_dir.clone(),
+        config.outputs.state_dir.clone(),
+    );
+    let options = RunOptions {
+        duration_s: Some(1.0),
+        ..RunOptions::default()
+    };
+    let (first_events, first_said) = kept_events();
+    run_blocking(
+        config.clone(),
+        options.clone(),
+        first_events,
+        std::future::pending(),
+    )
+    .unwrap();
+    assert!(
+        entries(&state_dir).contains(&"baselines.json".to_owned()),
+        "saved at the stop: {:?}",
+        entries(&state_dir)
+    );
+
+    // The first run released its locks: the second starts, and starts from the saved state.
+    let (events, said) = kept_events();
+    run_blocking(config, options, events, std::future::pending()).unwrap();
+    let said = said.lock().unwrap().join("\n");
+    assert!(said.contains("StateLoaded"), "{said}");
+    assert!(!said.contains("NoState"), "{said}");
+    assert!(!said.contains("StaleLockTakenOver"), "a clean stop: {said}");
+    let first_said = first_said.lock().unwrap();
+    assert!(
+        !first_said.iter().any(|line| line.starts_with("State(")),
+        "no state problem: {first_said:?}"
+    );
+    let logs = entries(&mcap_dir)
+        .into_iter()
+        .filter(|name| name.ends_with(".mcap"))
+        .count();
+    assert_eq!(logs, 2, "one log per run: {:?}", entries(&mcap_dir));
+}
+
+#[test]
+fn a_shutdown_stops_a_run_of_a_simulated_sensor_in_real_time() {
+    let scratch = Scratch::new("shutdown");
+    let config = sim_config(scratch.path());
+    let options = RunOptions {
+        duration_s: None,
+        realtime: true,
+        status_lines: false,
+    };
+    let started = Instant::now();
+    let shutdown = async { tokio::time::sleep(Duration::from_millis(500)).await };
+    let summary = run_blocking(config, options, ignore_events(), shutdown).unwrap();
+    let took = started.elapsed();
+    assert!(
+        took < Duration::from_secs(3),
+        "the run took {took:?} to stop"
+    );
+    let channel = &summary.channels[0];
+    // Paced at real time: about the half second it ran, not as fast as the analysis goes.
+    assert!(
+        channel.seconds > 0.0 && channel.seconds <= took.as_secs_f64() + 0.2,
+        "{} s of samples in {took:?}",
+        channel.seconds
+    );
 }
 
 #[test]
