@@ -21,6 +21,19 @@ pub fn ignore_events() -> Events {
     Arc::new(|_| {})
 }
 
+/// Events that keep what they were told, one `Debug` line each (for tests that check what
+/// the operator is told).
+#[cfg(test)]
+pub fn kept_events() -> (Events, Arc<std::sync::Mutex<Vec<String>>>) {
+    let kept = Arc::new(std::sync::Mutex::new(Vec::new()));
+    let events: Events = {
+        let kept = kept.clone();
+        #[allow(clippy::unwrap_used)]
+        Arc::new(move |event| kept.lock().unwrap().push(format!("{event:?}")))
+    };
+    (events, kept)
+}
+
 /// Something the operator should know.
 #[derive(Debug)]
 pub enum DaemonEvent {

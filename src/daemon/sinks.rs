@@ -220,11 +220,11 @@ fn start_alerts(_config: &Config, events: &Events) -> Result<AlertsStarted, Sink
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::daemon::events::kept_events;
     use crate::messages::PipelineMessage;
     use crate::pipeline::SinkError;
     use bearingd_testdata::scratch_dir;
     use std::path::Path;
-    use std::sync::{Arc, Mutex};
 
     /// A caller's sink that takes everything and keeps nothing.
     struct Printer;
@@ -251,16 +251,6 @@ mod tests {
         .unwrap();
         config.fleet = Some(fleet);
         config
-    }
-
-    /// Events that keep what they were told, one line each.
-    fn kept_events() -> (Events, Arc<Mutex<Vec<String>>>) {
-        let kept = Arc::new(Mutex::new(Vec::new()));
-        let events: Events = {
-            let kept = kept.clone();
-            Arc::new(move |event| kept.lock().unwrap().push(format!("{event:?}")))
-        };
-        (events, kept)
     }
 
     fn log_files(config: &Config) -> usize {

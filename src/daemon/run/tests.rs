@@ -3,8 +3,7 @@
 
 use super::*;
 use crate::config::parse;
-use crate::daemon::events::ignore_events;
-use std::sync::Mutex;
+use crate::daemon::events::{ignore_events, kept_events};
 use std::time::Instant;
 
 /// A directory of its own under the system's temporary directory, removed when dropped.
@@ -57,16 +56,6 @@ fn log_only() -> SinkPlan {
         fleet: false,
         extra: Vec::new(),
     }
-}
-
-/// Events that keep what they were told, one `Debug` line each.
-fn kept_events() -> (Events, Arc<Mutex<Vec<String>>>) {
-    let kept = Arc::new(Mutex::new(Vec::new()));
-    let events: Events = {
-        let kept = kept.clone();
-        Arc::new(move |event| kept.lock().unwrap().push(format!("{event:?}")))
-    };
-    (events, kept)
 }
 
 /// A run of these tests that has not returned by then never will: a failure, not a hang.
