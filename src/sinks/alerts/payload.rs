@@ -263,13 +263,13 @@ impl AlertView {
 }
 
 /// A raised outer-race alert of sensor `s` for the alert tests: `run_id` and `sequence` as
-/// given, its end sample 100 per sequence number.
+/// given, its end sample 100 per sequence number (saturating: the tests also send `u64::MAX`).
 #[cfg(test)]
 pub(crate) fn test_alert(run_id: u64, sequence: u64) -> Alert {
     Alert {
         sequence,
         run_id,
-        end_sample: sequence * 100,
+        end_sample: sequence.saturating_mul(100),
         wall_time_ns: 0,
         sample_rate_hz: 12_000.0,
         fault_frequency_hz: 107.0,
