@@ -16,10 +16,12 @@
 //! `BENCH_WINDOWS=N` (issue 12, "p99 < 1 ms over 10,000 windows"): one round instead, long
 //! enough for N analysis windows over all sensors, every sensor faulty from the start and the
 //! flags made to chatter (one window per average, thresholds at the middle of the scores, no
-//! delays, almost no hysteresis), so that about 40 % of the windows raise or clear an alert:
-//! thousands of alerts, enough for p99 and p999 of a window's alert. Only the thresholds and
-//! the averaging differ from the default config; the analysis, band selections and twin re-fits
-//! are the default's. `BENCH_BEARINGD=path` runs another build of the daemon (a before/after
+//! delays, almost no hysteresis, and an imbalance at the ISO zone B/C boundary so that the
+//! per-window `iso_zone` flag flips; the fault flags follow band selections and change at most
+//! once per band period), so that about 40 % of the windows raise or clear an alert:
+//! thousands of alerts, enough for p99 and p999 of a window's alert. Only the thresholds, the
+//! averaging and the imbalance differ from the default config; the analysis, band selections
+//! and twin re-fits are the default's. `BENCH_BEARINGD=path` runs another build of the daemon (a before/after
 //! comparison on the same machine load). `BENCH_CPU_WAKEUP_US=N` sets the daemon's
 //! `outputs.cpu_wakeup_latency_us` (the CPUs' wake-up latency capped while it runs; left out by
 //! default, as in the default config).
@@ -30,7 +32,10 @@ mod common;
 use bearingd::clock::wall_clock_now_ns;
 use bearingd::iox::IoxSettings;
 use bearingd::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
-use common::{env_or, percentile, simulated_sensors, CHATTERING_THRESHOLDS};
+use common::{
+    env_or, percentile, simulated_sensors, CHATTERING_IMBALANCE_G, CHATTERING_THRESHOLDS,
+    DEFAULT_IMBALANCE_G,
+};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -50,13 +55,13 @@ fn write_config(
     if chatter {
         text.push_str(CHATTERING_THRESHOLDS);
     }
-    text += &simulated_sensors(sensors, rate, |j| {
-        if chatter {
-            0.0
-        } else {
-            2.0 + 2.5 * j as f64
-        }
-    });
+    let imbalance_g = if chatter {
+        CHATTERING_IMBALANCE_G
+    } else {
+        DEFAULT_IMBALANCE_G
+    };
+    let onset_s = |j: usize| if chatter { 0.0 } else { 2.0 + 2.5 * j as f64 };
+    text += &simulated_sensors(sensors, rate, onset_s, imbalance_g);
     let _ = write!(
         text,
         r#"

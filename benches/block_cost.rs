@@ -23,12 +23,15 @@ use bearingd::config::{parse, Transport};
 use bearingd::messages::PipelineMessage;
 use bearingd::pipeline::{Output, Pipeline};
 use bearingd::sources::sim::SimSource;
-use common::{env_or, percentile, simulated_sensors, CHATTERING_THRESHOLDS};
+use common::{
+    env_or, percentile, simulated_sensors, CHATTERING_IMBALANCE_G, CHATTERING_THRESHOLDS,
+};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
 fn config_text(sensors: usize) -> String {
-    CHATTERING_THRESHOLDS.to_string() + &simulated_sensors(sensors, 25_600, |_| 0.0)
+    CHATTERING_THRESHOLDS.to_string()
+        + &simulated_sensors(sensors, 25_600, |_| 0.0, CHATTERING_IMBALANCE_G)
 }
 
 fn report(what: &str, mut values_us: Vec<f64>) {
