@@ -69,12 +69,19 @@ fn main() {
                 let started = Instant::now();
                 let mut first_flag_us = None;
                 let mut windows = 0;
-                pipeline.handle(input, &mut |output| match output {
-                    Output::Message(PipelineMessage::Flag(_)) => {
+                pipeline.handle(input, &mut |output| {
+                    // A fault flag's change, or a detector's (the ISO zone flag chatters here).
+                    let flag = match &output {
+                        Output::Message(PipelineMessage::Flag(_)) => true,
+                        Output::Message(PipelineMessage::Detector(m)) => m.as_flag().is_some(),
+                        _ => false,
+                    };
+                    if flag {
                         first_flag_us.get_or_insert_with(|| started.elapsed().as_secs_f64() * 1e6);
                     }
-                    Output::Message(PipelineMessage::Indicators(_)) => windows += 1,
-                    _ => {}
+                    if matches!(output, Output::Message(PipelineMessage::Indicators(_))) {
+                        windows += 1;
+                    }
                 });
                 let took_us = started.elapsed().as_secs_f64() * 1e6;
                 match (windows, first_flag_us) {
