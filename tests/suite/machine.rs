@@ -302,15 +302,7 @@ fn machine_flags(log: &serde_json::Value) -> Vec<(String, String, String, u64)> 
 #[test]
 fn analyze_names_each_simulated_machine_fault_in_its_json_and_none_without() {
     let dir = bearingd_testdata::scratch_dir("machine-analyze");
-    let run = |args: &[&str]| {
-        let out = bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd"), args);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout).into_owned()
-    };
+    let run = crate::severity::run_ok;
     for kind in [
         None,
         Some("unbalance"),
@@ -368,15 +360,7 @@ fn analyze_says_a_record_too_short_for_half_orders_is_not_judged() {
     let dir = bearingd_testdata::scratch_dir("machine-short");
     let csv = dir.join("short.csv");
     let csv = csv.to_str().unwrap();
-    let run = |args: &[&str]| {
-        let out = bearingd_testdata::run_binary(env!("CARGO_BIN_EXE_bearingd"), args);
-        assert!(
-            out.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout).into_owned()
-    };
+    let run = crate::severity::run_ok;
     run(&[
         "simulate",
         "--fault",
