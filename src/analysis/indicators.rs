@@ -47,34 +47,7 @@ pub fn sum_of(parts: &[&[f32]]) -> f64 {
 impl Indicators {
     /// Indicators of `samples`, which may come as several slices (a ring buffer's halves).
     pub fn of_slices(parts: &[&[f32]]) -> Self {
-        let count: usize = parts.iter().map(|p| p.len()).sum();
-        if count == 0 {
-            return Indicators::default();
-        }
-        let n = count as f64;
-        let mean = sum_of(parts) / n;
-        let (mut m2, mut m4, mut peaks) = ([0.0f64; LANES], [0.0f64; LANES], [0.0f64; LANES]);
-        for_each_lane(parts, |lane, x| {
-            let d = f64::from(x) - mean;
-            let d2 = d * d;
-            m2[lane] += d2;
-            m4[lane] += d2 * d2;
-            peaks[lane] = peaks[lane].max(d.abs());
-        });
-        let (m2, m4) = (m2.iter().sum::<f64>(), m4.iter().sum::<f64>());
-        let peak = peaks.iter().copied().fold(0.0, f64::max);
-        let variance = m2 / n;
-        let rms = variance.sqrt();
-        Indicators {
-            rms,
-            peak,
-            crest: if rms > 0.0 { peak / rms } else { 0.0 },
-            kurtosis: if variance > 0.0 {
-                (m4 / n) / (variance * variance)
-            } else {
-                0.0
-            },
-        }
+        Moments::of(parts).indicators()
     }
 
     pub fn of(samples: &[f32]) -> Self {
