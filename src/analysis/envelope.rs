@@ -378,6 +378,26 @@ impl RollingBand {
     }
 }
 
+/// A hop's window as soon as its FFT is done, before any band's envelope: what decides on the
+/// window alone (a detector on its spectrum, the indicators on its samples) runs here, so that
+/// its flag, and the alert it may raise, never waits for the bands.
+pub struct WindowReady<'a> {
+    /// Sample index (in the channel's sample time) one past the last sample of the window.
+    pub end_sample: u64,
+    /// The raw samples of the window, oldest first, as two slices of the ring buffer.
+    pub window_samples: (&'a [f32], &'a [f32]),
+    /// The real FFT of those samples (no window function), `window / 2 + 1` bins.
+    pub window_spectrum: &'a [Complex32],
+}
+
+/// The two stages of a hop, in this order ([`RollingEnvelope::push_staged`]).
+pub enum HopStage<'a> {
+    /// The window's FFT is done; the bands are not.
+    Window(&'a WindowReady<'a>),
+    /// Every band's envelope spectrum and average is done too.
+    Bands(&'a EnvelopeUpdate<'a>),
+}
+
 /// One update of the rolling envelope spectrum, handed to the caller every hop.
 pub struct EnvelopeUpdate<'a> {
     /// Sample index (in the channel's sample time) one past the last sample of the window.
@@ -528,7 +548,17 @@ impl RollingEnvelope {
     }
 
     /// Feeds samples; calls `on_update` once per completed hop.
-    pub fn push(&mut self, mut samples: &[f32], mut on_update: impl FnMut(&EnvelopeUpdate)) {
+    pub fn push(&mut self, samples: &[f32], mut on_update: impl FnMut(&EnvelopeUpdate)) {
+        self.push_staged(samples, |stage| {
+            if let HopStage::Bands(update) = stage {
+                on_update(update);
+            }
+        });
+    }
+
+    /// Feeds samples; calls `on_hop` twice per completed hop: with the window once its FFT is
+    /// done, then with the update once the bands are done.
+    pub fn push_staged(&mut self, mut samples: &[f32], mut on_hop: impl FnMut(HopStage)) {
         let window = self.ring.len();
         while !samples.is_empty() {
             let take = samples
@@ -542,14 +572,20 @@ impl RollingEnvelope {
             self.samples_seen += take as u64;
             if self.until_update == 0 {
                 self.until_update = self.hop;
-                self.update(&mut on_update);
+                self.update(&mut on_hop);
             }
         }
     }
 
-    fn update(&mut self, on_update: &mut impl FnMut(&EnvelopeUpdate)) {
+    fn update(&mut self, on_hop: &mut impl FnMut(HopStage)) {
         let (newer, older) = self.ring.split_at(self.write_at);
-        let spectrum = self.transform.transform(older, newer);
+        self.transform.transform(older, newer);
+        on_hop(HopStage::Window(&WindowReady {
+            end_sample: self.samples_seen,
+            window_samples: (older, newer),
+            window_spectrum: self.transform.spectrum(),
+        }));
+        let spectrum = self.transform.spectrum();
         let slot = self.history_next;
         self.history_next = (self.history_next + 1) % self.averages;
         self.history_used = (self.history_used + 1).min(self.averages);
@@ -571,7 +607,7 @@ impl RollingEnvelope {
             }
         }
         let (newer, older) = self.ring.split_at(self.write_at);
-        on_update(&EnvelopeUpdate {
+        on_hop(HopStage::Bands(&EnvelopeUpdate {
             end_sample: self.samples_seen,
             bin_hz: self.fs_hz / self.ring.len() as f64,
             windows_averaged: self.history_used,
@@ -579,7 +615,7 @@ impl RollingEnvelope {
             band_of: &self.band_of,
             window_samples: (older, newer),
             window_spectrum: self.transform.spectrum(),
-        });
+        }));
     }
 }
 

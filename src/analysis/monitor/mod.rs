@@ -62,7 +62,7 @@ use super::band::envelope_range_hz;
 use super::band_selection::{scaled, usable_shaft_hz, BandSelector, InlineSelector};
 use super::degradation::RmsTrend;
 use super::detect::{share_of, ChannelContext, ChannelDetector, WindowView};
-use super::envelope::{window_samples, RollingEnvelope};
+use super::envelope::{window_samples, HopStage, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::FaultFlag;
 use super::health::{Baseline, HealthTracker, CONFIRM_WINDOWS};
@@ -489,7 +489,7 @@ impl ChannelMonitor {
 
         let ChannelMonitor {
             rolling,
-            indicators: window_indicators,
+            indicators,
             detectors,
             scorer,
             health,
@@ -501,57 +501,68 @@ impl ChannelMonitor {
             ..
         } = self;
         let speed_known = *speed_known;
-        rolling.push(samples, |update| {
-            // Before the first band selection there are no band engines: nothing to score; nor
-            // without a speed to score against. Each band's spectrum is prepared once, in the
-            // scorer slot of its engine (at most the fault's index; faults whose best band is
-            // the same share it), then scored for its faults.
-            let slot = |i: usize| update.band_of.get(i).copied().unwrap_or(i);
-            let mut prepared = [false; FaultKind::ALL.len()];
-            for (i, kind) in FaultKind::ALL.iter().enumerate() {
-                let spectrum = update
-                    .band(i)
-                    .filter(|_| speed_known)
-                    .map_or(&[][..], |b| b.averaged_amplitude());
-                if !std::mem::replace(&mut prepared[slot(i)], true) {
-                    scorer.prepare(slot(i), spectrum, update.bin_hz, freqs);
+        // What decides on the window alone (detectors, indicators, health stage, trend) runs
+        // as soon as its FFT is done, before the bands: its flags and alerts never wait for
+        // the band envelopes and fault scores, which only feed the window's report.
+        let mut window_indicators = None;
+        rolling.push_staged(samples, |stage| match stage {
+            HopStage::Window(ready) => {
+                let window = WindowView {
+                    end_sample: ready.end_sample,
+                    spectrum: ready.window_spectrum,
+                    shaft_hz: speed_known.then_some(freqs.shaft),
+                };
+                for detector in detectors.iter_mut() {
+                    detector.on_window(&window, &mut |m| on_event(MonitorEvent::Detector(m)));
                 }
-                scores[i] = scorer.score_prepared(slot(i), spectrum, *kind, freqs);
+                let indicators = indicators.of_window(ready.end_sample, ready.window_samples);
+                if let Some(change) =
+                    health.update(indicators.kurtosis, indicators.rms, ready.end_sample)
+                {
+                    on_event(MonitorEvent::Stage(change));
+                }
+                let stage = health.stage();
+                let threshold = health
+                    .failure_limit()
+                    .filter(|_| stage >= HealthStage::Degrading);
+                if let Some(point) = trend.push(indicators.rms, ready.end_sample, threshold) {
+                    on_event(MonitorEvent::Trend { point, stage });
+                }
+                window_indicators = Some(indicators);
             }
-            let window = WindowView {
-                end_sample: update.end_sample,
-                spectrum: update.window_spectrum,
-                shaft_hz: speed_known.then_some(freqs.shaft),
-            };
-            for detector in detectors.iter_mut() {
-                detector.on_window(&window, &mut |m| on_event(MonitorEvent::Detector(m)));
+            HopStage::Bands(update) => {
+                // Before the first band selection there are no band engines: nothing to score;
+                // nor without a speed to score against. Each band's spectrum is prepared once,
+                // in the scorer slot of its engine (at most the fault's index; faults whose best
+                // band is the same share it), then scored for its faults.
+                let slot = |i: usize| update.band_of.get(i).copied().unwrap_or(i);
+                let mut prepared = [false; FaultKind::ALL.len()];
+                for (i, kind) in FaultKind::ALL.iter().enumerate() {
+                    let spectrum = update
+                        .band(i)
+                        .filter(|_| speed_known)
+                        .map_or(&[][..], |b| b.averaged_amplitude());
+                    if !std::mem::replace(&mut prepared[slot(i)], true) {
+                        scorer.prepare(slot(i), spectrum, update.bin_hz, freqs);
+                    }
+                    scores[i] = scorer.score_prepared(slot(i), spectrum, *kind, freqs);
+                }
+                let top = (0..4)
+                    .max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))
+                    .unwrap_or(0);
+                // The window stage came first in this hop; its indicators are this window's.
+                let indicators = window_indicators.take().unwrap_or_default();
+                on_event(MonitorEvent::Window(WindowReport {
+                    end_sample: update.end_sample,
+                    indicators,
+                    scores,
+                    bands,
+                    spectrum: update.band(top).map_or(&[][..], |b| b.averaged_amplitude()),
+                    spectrum_band: update.band(top).map_or(bands[top], |b| b.band()),
+                    bin_hz: update.bin_hz,
+                    windows_averaged: update.windows_averaged,
+                }));
             }
-            let indicators = window_indicators.of_window(update.end_sample, update.window_samples);
-            if let Some(change) =
-                health.update(indicators.kurtosis, indicators.rms, update.end_sample)
-            {
-                on_event(MonitorEvent::Stage(change));
-            }
-            let stage = health.stage();
-            let threshold = health
-                .failure_limit()
-                .filter(|_| stage >= HealthStage::Degrading);
-            if let Some(point) = trend.push(indicators.rms, update.end_sample, threshold) {
-                on_event(MonitorEvent::Trend { point, stage });
-            }
-            let top = (0..4)
-                .max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))
-                .unwrap_or(0);
-            on_event(MonitorEvent::Window(WindowReport {
-                end_sample: update.end_sample,
-                indicators,
-                scores,
-                bands,
-                spectrum: update.band(top).map_or(&[][..], |b| b.averaged_amplitude()),
-                spectrum_band: update.band(top).map_or(bands[top], |b| b.band()),
-                bin_hz: update.bin_hz,
-                windows_averaged: update.windows_averaged,
-            }));
         });
     }
 
