@@ -61,3 +61,35 @@ pub fn simulated_sensors(
     }
     text
 }
+
+/// The machine's own jitter, the floor under any latency tail measured on it: a fixed amount of
+/// arithmetic (calibrated to take about `work_us` here, the size of one window's analysis),
+/// done `rounds` times, each after a 2 ms sleep as the analysis thread sleeps between blocks.
+/// Returns the durations in ms, ascending. On a virtual machine the p99 of this alone can be
+/// several times its median (a host that takes the CPU away is not visible from inside).
+pub fn host_jitter_ms(work_us: f64, rounds: usize) -> Vec<f64> {
+    fn spin(iterations: u64) -> f64 {
+        let mut acc = 0.0f64;
+        for k in 0..iterations {
+            acc = std::hint::black_box(acc + k as f64 * 1e-9);
+        }
+        acc
+    }
+    let timed = |iterations: u64| {
+        let started = std::time::Instant::now();
+        std::hint::black_box(spin(iterations));
+        started.elapsed().as_secs_f64() * 1e3
+    };
+    // Iterations per µs: the fastest of a few calibration runs (the least disturbed).
+    let probe = 200_000u64;
+    let fastest_ms = (0..20).map(|_| timed(probe)).fold(f64::INFINITY, f64::min);
+    let iterations = (probe as f64 * work_us / (fastest_ms * 1e3)).max(1.0) as u64;
+    let mut durations: Vec<f64> = (0..rounds)
+        .map(|_| {
+            std::thread::sleep(std::time::Duration::from_millis(2));
+            timed(iterations)
+        })
+        .collect();
+    durations.sort_by(f64::total_cmp);
+    durations
+}
