@@ -8,6 +8,7 @@
 #[cfg(feature = "shm")]
 mod alerts;
 pub mod analyze;
+pub mod completions;
 mod config_cmd;
 mod fleet_decode;
 mod hw_table;
@@ -18,7 +19,7 @@ mod progress;
 mod replay;
 mod run;
 
-use clap::{Args, Parser, Subcommand};
+use clap::{Args, CommandFactory, Parser, Subcommand};
 use std::process::ExitCode;
 
 /// How to read a recording and what it was taken under: shared by `analyze` and `import`.
@@ -135,6 +136,19 @@ enum Command {
         #[command(subcommand)]
         action: config_cmd::ConfigAction,
     },
+    /// Print the shell completion script for bash, zsh, fish, elvish or powershell on stdout
+    /// (docs/OPERATIONS.md "Completions and man pages" says where each shell reads it).
+    Completions {
+        /// The shell to complete in.
+        #[arg(value_enum)]
+        shell: completions::Shell,
+    },
+}
+
+/// The service's command line as clap sees it: what the lab renders the completion scripts and
+/// the man pages from (the service links neither generator, see [`completions`]).
+pub fn command() -> clap::Command {
+    Cli::command()
 }
 
 /// Parses the command line, runs the command, prints errors, returns the exit code.
@@ -178,6 +192,7 @@ pub fn main() -> ExitCode {
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),
         Command::FleetDecode(args) => fleet_decode::run(&args),
+        Command::Completions { shell } => completions::run(shell),
         #[cfg(feature = "shm")]
         Command::Alerts(args) => alerts::run(&args),
     };

@@ -346,3 +346,46 @@ fn output_into_a_pipe_closed_early_ends_without_a_panic() {
         out.status
     );
 }
+
+/// `bearingd completions bash` offers every command the service's clap command has, read off the
+/// command and not a list (a new command without its completion fails here); every shell gets a
+/// script; an unknown shell is bad input.
+#[test]
+fn completions_offer_every_command_of_the_service() {
+    let out = bearingd(&["completions", "bash"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let script = String::from_utf8(out.stdout).expect("UTF-8 script");
+    // The top level's words: the `opts=` line right after the `bearingd)` case.
+    let lines: Vec<&str> = script.lines().collect();
+    let case = lines
+        .iter()
+        .position(|line| line.trim() == "bearingd)")
+        .expect("the script has no `bearingd)` case");
+    let opts = lines[case + 1].trim();
+    assert!(opts.starts_with("opts=\""), "{opts}");
+    let words: Vec<&str> = opts["opts=\"".len()..]
+        .trim_end_matches('"')
+        .split_whitespace()
+        .collect();
+    let command = bearingd::cli::command();
+    let names: Vec<&str> = command.get_subcommands().map(|c| c.get_name()).collect();
+    assert!(names.len() >= 10, "{names:?}");
+    for name in &names {
+        assert!(
+            words.contains(name),
+            "bash completion lacks `{name}`: {opts}"
+        );
+    }
+    for shell in ["zsh", "fish", "elvish", "powershell"] {
+        let out = bearingd(&["completions", shell]);
+        assert!(out.status.success(), "{shell}: {}", stderr(&out));
+        let script = String::from_utf8_lossy(&out.stdout);
+        for name in &names {
+            assert!(script.contains(name), "{shell} completion lacks `{name}`");
+        }
+    }
+    let out = bearingd(&["completions", "tcsh"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("tcsh") && err.contains("bash"), "{err}");
+}

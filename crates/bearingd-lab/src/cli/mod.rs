@@ -5,6 +5,7 @@
 mod analyze;
 mod calibrate;
 mod dataset;
+pub mod docs;
 mod evaluate;
 mod simulate;
 mod train;
@@ -50,6 +51,18 @@ enum Command {
     /// Diagnose a recording as `bearingd analyze` does, and draw the envelope spectrum and the
     /// kurtogram with --plot (`bearingd analyze --plot` runs this).
     Analyze(bearingd::cli::analyze::AnalyzeArgs),
+    /// Print the shell completion script of bearingd-lab (or, with --program bearingd, of the
+    /// service) for bash, zsh, fish, elvish or powershell; with --out DIR write them all.
+    Completions(docs::CompletionsArgs),
+    /// Write the man pages of bearingd and bearingd-lab and of each of their commands into a
+    /// directory (`make install` installs the committed ones, docs/cli/man).
+    Man(docs::ManArgs),
+}
+
+/// The lab's command line as clap sees it (the lab's tests compare the pages and scripts with it).
+pub fn command() -> clap::Command {
+    use clap::CommandFactory;
+    Cli::command()
 }
 
 /// Parses the command line, runs the command, prints errors, returns the exit code. Every lab
@@ -65,6 +78,8 @@ pub fn main() -> ExitCode {
         Command::Evaluate(args) => evaluate::run(&args),
         Command::Trend(args) => trend::run(&args),
         Command::Analyze(args) => analyze::run(&args),
+        Command::Completions(args) => docs::run_completions(&args),
+        Command::Man(args) => docs::run_man(&args),
     };
     exit_code("bearingd-lab", result)
 }

@@ -1,0 +1,357 @@
+
+using namespace System.Management.Automation
+using namespace System.Management.Automation.Language
+
+Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
+    param($wordToComplete, $commandAst, $cursorPosition)
+
+    $commandElements = $commandAst.CommandElements
+    $command = @(
+        'bearingd'
+        for ($i = 1; $i -lt $commandElements.Count; $i++) {
+            $element = $commandElements[$i]
+            if ($element -isnot [StringConstantExpressionAst] -or
+                $element.StringConstantType -ne [StringConstantType]::BareWord -or
+                $element.Value.StartsWith('-') -or
+                $element.Value -eq $wordToComplete) {
+                break
+        }
+        $element.Value
+    }) -join ';'
+
+    $completions = @(switch ($command) {
+        'bearingd' {
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('-V', '-V ', [CompletionResultType]::ParameterName, 'Print version')
+            [CompletionResult]::new('--version', '--version', [CompletionResultType]::ParameterName, 'Print version')
+            [CompletionResult]::new('analyze', 'analyze', [CompletionResultType]::ParameterValue, 'Diagnose a recording (CWRU .mat, PRONOSTIA/IMS/plain CSV, WAV) or the built-in demo')
+            [CompletionResult]::new('run', 'run', [CompletionResultType]::ParameterValue, 'Run the service: sources → analysis → logs and alerts. Without --config, the embedded default: a simulated sensor that develops an outer-race fault after 30 s')
+            [CompletionResult]::new('import', 'import', [CompletionResultType]::ParameterValue, 'Convert a recording (.mat, .csv, WAV) into a raw MCAP log and a config to replay it with')
+            [CompletionResult]::new('replay', 'replay', [CompletionResultType]::ParameterValue, 'Replay MCAP logs'' raw samples through the same pipeline, as fast as possible or at --speed')
+            [CompletionResult]::new('validate', 'validate', [CompletionResultType]::ParameterValue, 'Check a configuration file; lists every problem with its key and how to fix it')
+            [CompletionResult]::new('ingest', 'ingest', [CompletionResultType]::ParameterValue, 'Run one source (SocketCAN or iceoryx2) alone and report what arrived')
+            [CompletionResult]::new('alerts', 'alerts', [CompletionResultType]::ParameterValue, 'Print the daemon''s active alerts, then each alert as it comes (iceoryx2)')
+            [CompletionResult]::new('fleet-decode', 'fleet-decode', [CompletionResultType]::ParameterValue, 'Decode Sparkplug B messages of the fleet bridge: reads `TOPIC HEX` lines as printed by `mosquitto_sub -v -F ''%t %x'' -t ''spBv1.0/#''` and prints one JSON object per message')
+            [CompletionResult]::new('config', 'config', [CompletionResultType]::ParameterValue, 'Configuration helpers')
+            [CompletionResult]::new('completions', 'completions', [CompletionResultType]::ParameterValue, 'Print the shell completion script for bash, zsh, fish, elvish or powershell on stdout (docs/OPERATIONS.md "Completions and man pages" says where each shell reads it)')
+            [CompletionResult]::new('simulate', 'simulate', [CompletionResultType]::ParameterValue, 'Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV. Runs in bearingd-lab')
+            [CompletionResult]::new('dataset', 'dataset', [CompletionResultType]::ParameterValue, 'Generate a labelled synthetic data set (signal model or physics twin) for learned diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log. Runs in bearingd-lab')
+            [CompletionResult]::new('train', 'train', [CompletionResultType]::ParameterValue, 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab')
+            [CompletionResult]::new('calibrate', 'calibrate', [CompletionResultType]::ParameterValue, 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab')
+            [CompletionResult]::new('evaluate', 'evaluate', [CompletionResultType]::ParameterValue, 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot. Runs in bearingd-lab')
+            [CompletionResult]::new('trend', 'trend', [CompletionResultType]::ParameterValue, 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab')
+            [CompletionResult]::new('help', 'help', [CompletionResultType]::ParameterValue, 'Print this message or the help of the given subcommand(s)')
+            break
+        }
+        'bearingd;analyze' {
+            [CompletionResult]::new('--channel', '--channel', [CompletionResultType]::ParameterName, 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)')
+            [CompletionResult]::new('--column', '--column', [CompletionResultType]::ParameterName, 'Column of a CSV table: header name or 1-based index')
+            [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate in Hz (overrides what the file says)')
+            [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed in rpm (overrides what the file says)')
+            [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
+            [CompletionResult]::new('--plot', '--plot', [CompletionResultType]::ParameterName, 'Draw the envelope spectrum and the kurtogram to this file (.png or .svg); with several records, the record''s file name is added before the extension. Runs in bearingd-lab')
+            [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'Take the analysis settings from this configuration file''s [analysis] section, and its twin.learned_model unless --learned is given: the daemon''s decision, offline')
+            [CompletionResult]::new('--band-selection', '--band-selection', [CompletionResultType]::ParameterName, 'How to choose the resonance band')
+            [CompletionResult]::new('--band', '--band', [CompletionResultType]::ParameterName, 'The band for --band-selection fixed, as LO-HI in Hz, e.g. 2000-4000')
+            [CompletionResult]::new('--window', '--window', [CompletionResultType]::ParameterName, 'Envelope-spectrum window length in seconds (rounded to a power of two samples)')
+            [CompletionResult]::new('--learned', '--learned', [CompletionResultType]::ParameterName, 'Add a learned model''s opinion (a .safetensors file of `bearingd train`; the shipped one for the SKF 6205-2RS: models/skf-6205-2rs.safetensors). It may settle what the envelope leaves open, never overrule it; the JSON gains `learned`')
+            [CompletionResult]::new('--machine-group', '--machine-group', [CompletionResultType]::ParameterName, 'ISO 10816-3 machine group for the velocity zones: 1 (above 300 kW, or shaft height from 315 mm) or 2 (15 to 300 kW, shaft height 160 to 315 mm)')
+            [CompletionResult]::new('--foundation', '--foundation', [CompletionResultType]::ParameterName, 'Foundation for the velocity zones: rigid or flexible')
+            [CompletionResult]::new('--hw-states', '--hw-states', [CompletionResultType]::ParameterName, 'With --hw: where the median filter sits in the virtual states'' chain of differences, raw_once (the raw signal, once: the seed''s reading) or each_order (every order''s output on its own); docs/HW.md compares them')
+            [CompletionResult]::new('--demo', '--demo', [CompletionResultType]::ParameterName, 'Analyse a built-in simulated record (outer-race fault, SKF 6205-2RS, 1772 rpm, 12 kHz)')
+            [CompletionResult]::new('--no-refine', '--no-refine', [CompletionResultType]::ParameterName, 'Do not refine the band per fault hypothesis by its fault-band SNR')
+            [CompletionResult]::new('--twin', '--twin', [CompletionResultType]::ParameterName, 'Also fit the signal-model twin for each fault hypothesis (adds `twin` to the JSON, the twin''s spectrum to the text and the plot)')
+            [CompletionResult]::new('--hw', '--hw', [CompletionResultType]::ParameterName, 'Instead of the diagnosis: identify the Hammerstein–Wiener model (seed 003) for state orders 0…9 on each record and print its accuracy and time per order, and the mean per directory (bearing)')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            break
+        }
+        'bearingd;run' {
+            [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'Configuration file; without it, the embedded default (a simulated sensor)')
+            [CompletionResult]::new('--duration', '--duration', [CompletionResultType]::ParameterName, 'Stop after this many seconds of sample time (default: run until SIGINT/SIGTERM)')
+            [CompletionResult]::new('--data-dir', '--data-dir', [CompletionResultType]::ParameterName, 'Where to keep state (DIR/state) and logs (DIR/mcap); overrides outputs.state_dir and outputs.mcap_dir of --config. Without --config, default ./bearingd-data')
+            [CompletionResult]::new('--fleet', '--fleet', [CompletionResultType]::ParameterName, 'Also publish to this MQTT broker (mqtt://HOST:PORT or mqtts://HOST:PORT) with the fleet bridge''s defaults, node id = this host''s name: a first look; a service sets [fleet] in its config (docs/FLEET.md)')
+            [CompletionResult]::new('--fast', '--fast', [CompletionResultType]::ParameterName, 'Run simulated sensors as fast as the analysis allows instead of in real time')
+            [CompletionResult]::new('--quiet', '--quiet', [CompletionResultType]::ParameterName, 'No status lines (flags and the summary are still printed)')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;import' {
+            [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Directory for the MCAP log and replay.toml')
+            [CompletionResult]::new('--channel', '--channel', [CompletionResultType]::ParameterName, 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)')
+            [CompletionResult]::new('--column', '--column', [CompletionResultType]::ParameterName, 'Column of a CSV table: header name or 1-based index')
+            [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate in Hz (overrides what the file says)')
+            [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed in rpm (overrides what the file says)')
+            [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
+            [CompletionResult]::new('--sensor', '--sensor', [CompletionResultType]::ParameterName, 'Sensor id in the log')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;replay' {
+            [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'Analyse with this configuration instead of the one the log was recorded with (needed for logs without it: older files, `bearingd import`)')
+            [CompletionResult]::new('--speed', '--speed', [CompletionResultType]::ParameterName, 'Replay speed: 1 = real time; default: as fast as possible')
+            [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Directory of the replay''s own MCAP log')
+            [CompletionResult]::new('--quiet', '--quiet', [CompletionResultType]::ParameterName, 'No progress (neither the bar on a terminal nor the lines elsewhere)')
+            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'Print the summary as JSON (flags with their sample times)')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;validate' {
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;ingest' {
+            [CompletionResult]::new('--can', '--can', [CompletionResultType]::ParameterName, 'Read SocketCAN interface IFACE (classic and FD frames)')
+            [CompletionResult]::new('--shm', '--shm', [CompletionResultType]::ParameterName, 'Subscribe to iceoryx2 service bearingd/accel/SENSOR')
+            [CompletionResult]::new('--iox-prefix', '--iox-prefix', [CompletionResultType]::ParameterName, 'iceoryx2 resource prefix (isolates test runs); default: iceoryx2''s')
+            [CompletionResult]::new('--iox-root', '--iox-root', [CompletionResultType]::ParameterName, 'iceoryx2 root path; default: iceoryx2''s')
+            [CompletionResult]::new('--duration', '--duration', [CompletionResultType]::ParameterName, 'Stop after this many seconds')
+            [CompletionResult]::new('--until-idle', '--until-idle', [CompletionResultType]::ParameterName, 'Stop once nothing arrived for this many seconds (after the first frame)')
+            [CompletionResult]::new('--sensor-timeout-ms', '--sensor-timeout-ms', [CompletionResultType]::ParameterName, 'A node silent this long is reported lost (ms)')
+            [CompletionResult]::new('--rcvbuf', '--rcvbuf', [CompletionResultType]::ParameterName, 'CAN socket receive buffer, bytes')
+            [CompletionResult]::new('--ready-file', '--ready-file', [CompletionResultType]::ParameterName, 'Write this file once the source is listening')
+            [CompletionResult]::new('--capture', '--capture', [CompletionResultType]::ParameterName, 'CAN: write the first --capture-frames frames in candump -l format here ("-": stdout)')
+            [CompletionResult]::new('--capture-frames', '--capture-frames', [CompletionResultType]::ParameterName, 'capture-frames')
+            [CompletionResult]::new('--expect-samples', '--expect-samples', [CompletionResultType]::ParameterName, 'Expect exactly N samples in every stream (node, axis)')
+            [CompletionResult]::new('--expect-streams', '--expect-streams', [CompletionResultType]::ParameterName, 'Expect exactly N streams')
+            [CompletionResult]::new('--expect-gaps', '--expect-gaps', [CompletionResultType]::ParameterName, 'Expect exactly N gaps in total')
+            [CompletionResult]::new('--expect-malformed', '--expect-malformed', [CompletionResultType]::ParameterName, 'Expect exactly N malformed frames in total')
+            [CompletionResult]::new('--expect-restarts', '--expect-restarts', [CompletionResultType]::ParameterName, 'Expect exactly N restarts in total (one per restarted stream)')
+            [CompletionResult]::new('--expect-sensor-lost', '--expect-sensor-lost', [CompletionResultType]::ParameterName, 'Expect exactly N sensor-lost reports in total (a sender that stops is lost once)')
+            [CompletionResult]::new('--block-when-full', '--block-when-full', [CompletionResultType]::ParameterName, 'iceoryx2: when the hand-off queue is full, wait (push back into iceoryx2) instead of dropping the oldest batch')
+            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'Print the report as JSON')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;alerts' {
+            [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'The daemon''s config file (for its alert service and iceoryx2 root); without it, those of `bearingd run` without a config')
+            [CompletionResult]::new('--data-dir', '--data-dir', [CompletionResultType]::ParameterName, 'The `--data-dir` of a `bearingd run` without a config (default ./bearingd-data)')
+            [CompletionResult]::new('--count', '--count', [CompletionResultType]::ParameterName, 'Exit after this many alerts (the active alerts printed at start count)')
+            [CompletionResult]::new('--timeout', '--timeout', [CompletionResultType]::ParameterName, 'Stop after this many seconds; with --count, an exit status of 1 if fewer came')
+            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'One JSON object per line instead of text')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;fleet-decode' {
+            [CompletionResult]::new('--pretty', '--pretty', [CompletionResultType]::ParameterName, 'Indent the JSON (one object over several lines)')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;config' {
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor)')
+            [CompletionResult]::new('help', 'help', [CompletionResultType]::ParameterValue, 'Print this message or the help of the given subcommand(s)')
+            break
+        }
+        'bearingd;config;default' {
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;config;help' {
+            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor)')
+            [CompletionResult]::new('help', 'help', [CompletionResultType]::ParameterValue, 'Print this message or the help of the given subcommand(s)')
+            break
+        }
+        'bearingd;config;help;default' {
+            break
+        }
+        'bearingd;config;help;help' {
+            break
+        }
+        'bearingd;completions' {
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;simulate' {
+            [CompletionResult]::new('--model', '--model', [CompletionResultType]::ParameterName, 'Which model makes the record')
+            [CompletionResult]::new('--fault', '--fault', [CompletionResultType]::ParameterName, 'The defect')
+            [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed, rpm')
+            [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: catalog name or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0"')
+            [CompletionResult]::new('--duration', '--duration', [CompletionResultType]::ParameterName, 'Length of the record: seconds, e.g. 10 or 10s')
+            [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate, Hz')
+            [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Output file: .csv (one column, g) or .wav (32-bit float, g)')
+            [CompletionResult]::new('--load', '--load', [CompletionResultType]::ParameterName, 'Physics model: radial load, N')
+            [CompletionResult]::new('--defect-width', '--defect-width', [CompletionResultType]::ParameterName, 'Physics model: defect width, mm (CWRU: 0.178, 0.356, 0.533)')
+            [CompletionResult]::new('--damping-ratio', '--damping-ratio', [CompletionResultType]::ParameterName, 'Physics model: damping ratio of the resonator (its resonance is --resonance)')
+            [CompletionResult]::new('--dof', '--dof', [CompletionResultType]::ParameterName, 'Physics model: six degrees of freedom (seed 001) or five (seed 003)')
+            [CompletionResult]::new('--calibrated', '--calibrated', [CompletionResultType]::ParameterName, 'Physics model: parameters saved by `bearingd calibrate --save` (JSON); they replace the structure (k_r, c_r, k_b, …), the defect width, the load and the model; --fault, --rpm, --fs, --duration, --noise, --jitter and --seed still apply')
+            [CompletionResult]::new('--amplitude', '--amplitude', [CompletionResultType]::ParameterName, 'Signal model: impact amplitude a at full load, g')
+            [CompletionResult]::new('--decay', '--decay', [CompletionResultType]::ParameterName, 'Signal model: decay rate B of each impact, 1/s')
+            [CompletionResult]::new('--resonance', '--resonance', [CompletionResultType]::ParameterName, 'Structural resonance f_n, Hz (physics model: the resonator''s, which sets k_r)')
+            [CompletionResult]::new('--load-zone', '--load-zone', [CompletionResultType]::ParameterName, 'Signal model: Stribeck load-zone factor ε (0.5: half the bearing loaded)')
+            [CompletionResult]::new('--jitter', '--jitter', [CompletionResultType]::ParameterName, 'Impact-time jitter (slip), as a fraction of the impact period (physics model: the cage''s slip per ball pass)')
+            [CompletionResult]::new('--defect-length', '--defect-length', [CompletionResultType]::ParameterName, 'Signal model: defect length in mm (0: one impact per passage; above: entry and exit impacts)')
+            [CompletionResult]::new('--noise', '--noise', [CompletionResultType]::ParameterName, 'White noise, g (standard deviation)')
+            [CompletionResult]::new('--machine-fault', '--machine-fault', [CompletionResultType]::ParameterName, 'Signal model: add a fault of the machine (not of the bearing) at shaft orders')
+            [CompletionResult]::new('--machine-fault-velocity', '--machine-fault-velocity', [CompletionResultType]::ParameterName, 'RMS velocity of the machine fault''s 1× line, mm/s')
+            [CompletionResult]::new('--onset', '--onset', [CompletionResultType]::ParameterName, 'Signal model: the fault appears at this time, s')
+            [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Random seed: the same seed gives the same record')
+            [CompletionResult]::new('--nuisance', '--nuisance', [CompletionResultType]::ParameterName, 'Signal model: add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md)')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            break
+        }
+        'bearingd;dataset' {
+            [CompletionResult]::new('--spec', '--spec', [CompletionResultType]::ParameterName, 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml')
+            [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/')
+            [CompletionResult]::new('--mcap', '--mcap', [CompletionResultType]::ParameterName, 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;train' {
+            [CompletionResult]::new('--dataset', '--dataset', [CompletionResultType]::ParameterName, 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes and bearing), e.g. a signal-model and a physics set')
+            [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'The model file to write (.safetensors)')
+            [CompletionResult]::new('--epochs', '--epochs', [CompletionResultType]::ParameterName, 'Passes over the training segments')
+            [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'The seed of the initial weights, the corruption noise and the batch order')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;calibrate' {
+            [CompletionResult]::new('--channel', '--channel', [CompletionResultType]::ParameterName, 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)')
+            [CompletionResult]::new('--column', '--column', [CompletionResultType]::ParameterName, 'Column of a CSV table: header name or 1-based index')
+            [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate in Hz (overrides what the file says)')
+            [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed in rpm (overrides what the file says)')
+            [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
+            [CompletionResult]::new('--fault', '--fault', [CompletionResultType]::ParameterName, 'The defect to model; default: the envelope diagnosis of the record')
+            [CompletionResult]::new('--band', '--band', [CompletionResultType]::ParameterName, 'The band compared, as LO-HI in Hz; default: the band the envelope analysis chose for the fault')
+            [CompletionResult]::new('--load', '--load', [CompletionResultType]::ParameterName, 'Radial load on the bearing, N')
+            [CompletionResult]::new('--dof', '--dof', [CompletionResultType]::ParameterName, 'The model: six degrees of freedom (seed 001) or five (seed 003)')
+            [CompletionResult]::new('--population', '--population', [CompletionResultType]::ParameterName, 'Candidates per generation of the differential evolution')
+            [CompletionResult]::new('--generations', '--generations', [CompletionResultType]::ParameterName, 'Generations of the differential evolution')
+            [CompletionResult]::new('--simulated', '--simulated', [CompletionResultType]::ParameterName, 'Seconds simulated per candidate')
+            [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Seed of the search: the same seed gives the same calibration')
+            [CompletionResult]::new('--plot', '--plot', [CompletionResultType]::ParameterName, 'Draw the measured, calibrated and default spectra to this file (.png or .svg)')
+            [CompletionResult]::new('--save', '--save', [CompletionResultType]::ParameterName, 'Write the calibrated parameters as JSON (for `simulate --model physics --calibrated`)')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            break
+        }
+        'bearingd;evaluate' {
+            [CompletionResult]::new('--recordings', '--recordings', [CompletionResultType]::ParameterName, 'Instead of the simulator: every record of this manifest (CSV with a header: `file` relative to its folder, and `fault`, `note` or `life_frac` for the truth; `channel_var`, `fs_hz`, `rpm`, `bearing_geometry` where the file does not say) through `bearingd analyze` and through `bearingd import` + `replay`; writes recordings.json. May be given several times')
+            [CompletionResult]::new('--false-alarm-hours', '--false-alarm-hours', [CompletionResultType]::ParameterName, 'Instead of the sweep: H hours of healthy simulated signal per machine (the full sweep''s three machines at 0.6 and 1 × nominal speed, four noise levels, with the nuisance) streamed through the daemon''s channel monitor; counts the fault flags that rise (false alarms) per hour of operation; writes false_alarms.json and false_alarms.txt. Without a value: 2 h per machine (about 2.5 min of CPU)')
+            [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Directory for results.json, results.csv, table.txt and pd_vs_snr.svg (with --recordings: recordings.json and recordings.txt) (created)')
+            [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Seed of the sweep: the same seed gives the same records and results')
+            [CompletionResult]::new('--jobs', '--jobs', [CompletionResultType]::ParameterName, 'Worker threads (default: the machine''s cores)')
+            [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'Take the analysis and threshold settings from this config file instead of the embedded default (to evaluate a tuned configuration). With `twin.learned_model` the sweep''s record path also writes agreement_grid.txt (the learned model''s agreement decided at every point of a parameter grid); with --recordings only its agreement_* keys and model are used, by both paths')
+            [CompletionResult]::new('--all-channels', '--all-channels', [CompletionResultType]::ParameterName, 'With --recordings: also the other channels of each record (CWRU fan end and base, every axis of other files; IMS snapshots are always evaluated on all eight)')
+            [CompletionResult]::new('--strict', '--strict', [CompletionResultType]::ParameterName, 'With --recordings: exit 1 if any answer is confident and wrong, the paths disagree on any record, or any record fails (CI)')
+            [CompletionResult]::new('--quick', '--quick', [CompletionResultType]::ParameterName, 'The small sweep CI runs (both bearings at nominal speed, default severity, the simulator''s default noise and 0 dB SNR, healthy records) instead of the full one')
+            [CompletionResult]::new('--no-nuisance', '--no-nuisance', [CompletionResultType]::ParameterName, 'Leave out the machine''s nuisance (shaft harmonics, modulated noise, random impulses, gear and electrical tones): bearing, 1× tone and white noise only')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            break
+        }
+        'bearingd;trend' {
+            [CompletionResult]::new('--channel', '--channel', [CompletionResultType]::ParameterName, 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)')
+            [CompletionResult]::new('--column', '--column', [CompletionResultType]::ParameterName, 'Column of a CSV table: header name or 1-based index')
+            [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate in Hz (overrides what the file says)')
+            [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed in rpm (overrides what the file says)')
+            [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
+            [CompletionResult]::new('--plot', '--plot', [CompletionResultType]::ParameterName, 'Draw the stage timeline (RMS with the trend, kurtosis, HW residual, fault score) to this file (.png or .svg)')
+            [CompletionResult]::new('--baseline', '--baseline', [CompletionResultType]::ParameterName, 'Snapshots that form the healthy baseline (and the aging baseline of RMS)')
+            [CompletionResult]::new('--smoothing', '--smoothing', [CompletionResultType]::ParameterName, 'Running median over this many snapshots before the tracker (1: none)')
+            [CompletionResult]::new('--sigma', '--sigma', [CompletionResultType]::ParameterName, 'Standard deviations above a baseline that change the stage')
+            [CompletionResult]::new('--trend-window', '--trend-window', [CompletionResultType]::ParameterName, 'Snapshots in the sliding window of the RMS trend')
+            [CompletionResult]::new('--threshold-g', '--threshold-g', [CompletionResultType]::ParameterName, 'RMS threshold in g for the time-to-threshold (default: the failure limit the tracker learns at the start of degradation)')
+            [CompletionResult]::new('--interval', '--interval', [CompletionResultType]::ParameterName, 'Seconds between snapshots whose names state no time (e.g. other .mcap files), placed in name order')
+            [CompletionResult]::new('--window', '--window', [CompletionResultType]::ParameterName, 'Records longer than 1.5 windows (IMS, MCAP logs) are cut into windows of this many seconds, each one snapshot')
+            [CompletionResult]::new('--no-hw', '--no-hw', [CompletionResultType]::ParameterName, 'Do not identify the HW model per snapshot')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            break
+        }
+        'bearingd;help' {
+            [CompletionResult]::new('analyze', 'analyze', [CompletionResultType]::ParameterValue, 'Diagnose a recording (CWRU .mat, PRONOSTIA/IMS/plain CSV, WAV) or the built-in demo')
+            [CompletionResult]::new('run', 'run', [CompletionResultType]::ParameterValue, 'Run the service: sources → analysis → logs and alerts. Without --config, the embedded default: a simulated sensor that develops an outer-race fault after 30 s')
+            [CompletionResult]::new('import', 'import', [CompletionResultType]::ParameterValue, 'Convert a recording (.mat, .csv, WAV) into a raw MCAP log and a config to replay it with')
+            [CompletionResult]::new('replay', 'replay', [CompletionResultType]::ParameterValue, 'Replay MCAP logs'' raw samples through the same pipeline, as fast as possible or at --speed')
+            [CompletionResult]::new('validate', 'validate', [CompletionResultType]::ParameterValue, 'Check a configuration file; lists every problem with its key and how to fix it')
+            [CompletionResult]::new('ingest', 'ingest', [CompletionResultType]::ParameterValue, 'Run one source (SocketCAN or iceoryx2) alone and report what arrived')
+            [CompletionResult]::new('alerts', 'alerts', [CompletionResultType]::ParameterValue, 'Print the daemon''s active alerts, then each alert as it comes (iceoryx2)')
+            [CompletionResult]::new('fleet-decode', 'fleet-decode', [CompletionResultType]::ParameterValue, 'Decode Sparkplug B messages of the fleet bridge: reads `TOPIC HEX` lines as printed by `mosquitto_sub -v -F ''%t %x'' -t ''spBv1.0/#''` and prints one JSON object per message')
+            [CompletionResult]::new('config', 'config', [CompletionResultType]::ParameterValue, 'Configuration helpers')
+            [CompletionResult]::new('completions', 'completions', [CompletionResultType]::ParameterValue, 'Print the shell completion script for bash, zsh, fish, elvish or powershell on stdout (docs/OPERATIONS.md "Completions and man pages" says where each shell reads it)')
+            [CompletionResult]::new('simulate', 'simulate', [CompletionResultType]::ParameterValue, 'Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV. Runs in bearingd-lab')
+            [CompletionResult]::new('dataset', 'dataset', [CompletionResultType]::ParameterValue, 'Generate a labelled synthetic data set (signal model or physics twin) for learned diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log. Runs in bearingd-lab')
+            [CompletionResult]::new('train', 'train', [CompletionResultType]::ParameterValue, 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab')
+            [CompletionResult]::new('calibrate', 'calibrate', [CompletionResultType]::ParameterValue, 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab')
+            [CompletionResult]::new('evaluate', 'evaluate', [CompletionResultType]::ParameterValue, 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot. Runs in bearingd-lab')
+            [CompletionResult]::new('trend', 'trend', [CompletionResultType]::ParameterValue, 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab')
+            [CompletionResult]::new('help', 'help', [CompletionResultType]::ParameterValue, 'Print this message or the help of the given subcommand(s)')
+            break
+        }
+        'bearingd;help;analyze' {
+            break
+        }
+        'bearingd;help;run' {
+            break
+        }
+        'bearingd;help;import' {
+            break
+        }
+        'bearingd;help;replay' {
+            break
+        }
+        'bearingd;help;validate' {
+            break
+        }
+        'bearingd;help;ingest' {
+            break
+        }
+        'bearingd;help;alerts' {
+            break
+        }
+        'bearingd;help;fleet-decode' {
+            break
+        }
+        'bearingd;help;config' {
+            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor)')
+            break
+        }
+        'bearingd;help;config;default' {
+            break
+        }
+        'bearingd;help;completions' {
+            break
+        }
+        'bearingd;help;simulate' {
+            break
+        }
+        'bearingd;help;dataset' {
+            break
+        }
+        'bearingd;help;train' {
+            break
+        }
+        'bearingd;help;calibrate' {
+            break
+        }
+        'bearingd;help;evaluate' {
+            break
+        }
+        'bearingd;help;trend' {
+            break
+        }
+        'bearingd;help;help' {
+            break
+        }
+    })
+
+    $completions.Where{ $_.CompletionText -like "$wordToComplete*" } |
+        Sort-Object -Property ListItemText
+}

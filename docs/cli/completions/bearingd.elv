@@ -1,0 +1,312 @@
+
+use builtin;
+use str;
+
+set edit:completion:arg-completer[bearingd] = {|@words|
+    fn spaces {|n|
+        builtin:repeat $n ' ' | str:join ''
+    }
+    fn cand {|text desc|
+        edit:complex-candidate $text &display=$text' '(spaces (- 14 (wcswidth $text)))$desc
+    }
+    var command = 'bearingd'
+    for word $words[1..-1] {
+        if (str:has-prefix $word '-') {
+            break
+        }
+        set command = $command';'$word
+    }
+    var completions = [
+        &'bearingd'= {
+            cand -h 'Print help'
+            cand --help 'Print help'
+            cand -V 'Print version'
+            cand --version 'Print version'
+            cand analyze 'Diagnose a recording (CWRU .mat, PRONOSTIA/IMS/plain CSV, WAV) or the built-in demo'
+            cand run 'Run the service: sources → analysis → logs and alerts. Without --config, the embedded default: a simulated sensor that develops an outer-race fault after 30 s'
+            cand import 'Convert a recording (.mat, .csv, WAV) into a raw MCAP log and a config to replay it with'
+            cand replay 'Replay MCAP logs'' raw samples through the same pipeline, as fast as possible or at --speed'
+            cand validate 'Check a configuration file; lists every problem with its key and how to fix it'
+            cand ingest 'Run one source (SocketCAN or iceoryx2) alone and report what arrived'
+            cand alerts 'Print the daemon''s active alerts, then each alert as it comes (iceoryx2)'
+            cand fleet-decode 'Decode Sparkplug B messages of the fleet bridge: reads `TOPIC HEX` lines as printed by `mosquitto_sub -v -F ''%t %x'' -t ''spBv1.0/#''` and prints one JSON object per message'
+            cand config 'Configuration helpers'
+            cand completions 'Print the shell completion script for bash, zsh, fish, elvish or powershell on stdout (docs/OPERATIONS.md "Completions and man pages" says where each shell reads it)'
+            cand simulate 'Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV. Runs in bearingd-lab'
+            cand dataset 'Generate a labelled synthetic data set (signal model or physics twin) for learned diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log. Runs in bearingd-lab'
+            cand train 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab'
+            cand calibrate 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab'
+            cand evaluate 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot. Runs in bearingd-lab'
+            cand trend 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab'
+            cand help 'Print this message or the help of the given subcommand(s)'
+        }
+        &'bearingd;analyze'= {
+            cand --channel 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)'
+            cand --column 'Column of a CSV table: header name or 1-based index'
+            cand --fs 'Sample rate in Hz (overrides what the file says)'
+            cand --rpm 'Shaft speed in rpm (overrides what the file says)'
+            cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
+            cand --format 'Output format'
+            cand --plot 'Draw the envelope spectrum and the kurtogram to this file (.png or .svg); with several records, the record''s file name is added before the extension. Runs in bearingd-lab'
+            cand --config 'Take the analysis settings from this configuration file''s [analysis] section, and its twin.learned_model unless --learned is given: the daemon''s decision, offline'
+            cand --band-selection 'How to choose the resonance band'
+            cand --band 'The band for --band-selection fixed, as LO-HI in Hz, e.g. 2000-4000'
+            cand --window 'Envelope-spectrum window length in seconds (rounded to a power of two samples)'
+            cand --learned 'Add a learned model''s opinion (a .safetensors file of `bearingd train`; the shipped one for the SKF 6205-2RS: models/skf-6205-2rs.safetensors). It may settle what the envelope leaves open, never overrule it; the JSON gains `learned`'
+            cand --machine-group 'ISO 10816-3 machine group for the velocity zones: 1 (above 300 kW, or shaft height from 315 mm) or 2 (15 to 300 kW, shaft height 160 to 315 mm)'
+            cand --foundation 'Foundation for the velocity zones: rigid or flexible'
+            cand --hw-states 'With --hw: where the median filter sits in the virtual states'' chain of differences, raw_once (the raw signal, once: the seed''s reading) or each_order (every order''s output on its own); docs/HW.md compares them'
+            cand --demo 'Analyse a built-in simulated record (outer-race fault, SKF 6205-2RS, 1772 rpm, 12 kHz)'
+            cand --no-refine 'Do not refine the band per fault hypothesis by its fault-band SNR'
+            cand --twin 'Also fit the signal-model twin for each fault hypothesis (adds `twin` to the JSON, the twin''s spectrum to the text and the plot)'
+            cand --hw 'Instead of the diagnosis: identify the Hammerstein–Wiener model (seed 003) for state orders 0…9 on each record and print its accuracy and time per order, and the mean per directory (bearing)'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
+        }
+        &'bearingd;run'= {
+            cand --config 'Configuration file; without it, the embedded default (a simulated sensor)'
+            cand --duration 'Stop after this many seconds of sample time (default: run until SIGINT/SIGTERM)'
+            cand --data-dir 'Where to keep state (DIR/state) and logs (DIR/mcap); overrides outputs.state_dir and outputs.mcap_dir of --config. Without --config, default ./bearingd-data'
+            cand --fleet 'Also publish to this MQTT broker (mqtt://HOST:PORT or mqtts://HOST:PORT) with the fleet bridge''s defaults, node id = this host''s name: a first look; a service sets [fleet] in its config (docs/FLEET.md)'
+            cand --fast 'Run simulated sensors as fast as the analysis allows instead of in real time'
+            cand --quiet 'No status lines (flags and the summary are still printed)'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;import'= {
+            cand --out 'Directory for the MCAP log and replay.toml'
+            cand --channel 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)'
+            cand --column 'Column of a CSV table: header name or 1-based index'
+            cand --fs 'Sample rate in Hz (overrides what the file says)'
+            cand --rpm 'Shaft speed in rpm (overrides what the file says)'
+            cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
+            cand --sensor 'Sensor id in the log'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;replay'= {
+            cand --config 'Analyse with this configuration instead of the one the log was recorded with (needed for logs without it: older files, `bearingd import`)'
+            cand --speed 'Replay speed: 1 = real time; default: as fast as possible'
+            cand --out 'Directory of the replay''s own MCAP log'
+            cand --quiet 'No progress (neither the bar on a terminal nor the lines elsewhere)'
+            cand --json 'Print the summary as JSON (flags with their sample times)'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;validate'= {
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;ingest'= {
+            cand --can 'Read SocketCAN interface IFACE (classic and FD frames)'
+            cand --shm 'Subscribe to iceoryx2 service bearingd/accel/SENSOR'
+            cand --iox-prefix 'iceoryx2 resource prefix (isolates test runs); default: iceoryx2''s'
+            cand --iox-root 'iceoryx2 root path; default: iceoryx2''s'
+            cand --duration 'Stop after this many seconds'
+            cand --until-idle 'Stop once nothing arrived for this many seconds (after the first frame)'
+            cand --sensor-timeout-ms 'A node silent this long is reported lost (ms)'
+            cand --rcvbuf 'CAN socket receive buffer, bytes'
+            cand --ready-file 'Write this file once the source is listening'
+            cand --capture 'CAN: write the first --capture-frames frames in candump -l format here ("-": stdout)'
+            cand --capture-frames 'capture-frames'
+            cand --expect-samples 'Expect exactly N samples in every stream (node, axis)'
+            cand --expect-streams 'Expect exactly N streams'
+            cand --expect-gaps 'Expect exactly N gaps in total'
+            cand --expect-malformed 'Expect exactly N malformed frames in total'
+            cand --expect-restarts 'Expect exactly N restarts in total (one per restarted stream)'
+            cand --expect-sensor-lost 'Expect exactly N sensor-lost reports in total (a sender that stops is lost once)'
+            cand --block-when-full 'iceoryx2: when the hand-off queue is full, wait (push back into iceoryx2) instead of dropping the oldest batch'
+            cand --json 'Print the report as JSON'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;alerts'= {
+            cand --config 'The daemon''s config file (for its alert service and iceoryx2 root); without it, those of `bearingd run` without a config'
+            cand --data-dir 'The `--data-dir` of a `bearingd run` without a config (default ./bearingd-data)'
+            cand --count 'Exit after this many alerts (the active alerts printed at start count)'
+            cand --timeout 'Stop after this many seconds; with --count, an exit status of 1 if fewer came'
+            cand --json 'One JSON object per line instead of text'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;fleet-decode'= {
+            cand --pretty 'Indent the JSON (one object over several lines)'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;config'= {
+            cand -h 'Print help'
+            cand --help 'Print help'
+            cand default 'Print the documented default configuration (the embedded default: a simulated sensor)'
+            cand help 'Print this message or the help of the given subcommand(s)'
+        }
+        &'bearingd;config;default'= {
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;config;help'= {
+            cand default 'Print the documented default configuration (the embedded default: a simulated sensor)'
+            cand help 'Print this message or the help of the given subcommand(s)'
+        }
+        &'bearingd;config;help;default'= {
+        }
+        &'bearingd;config;help;help'= {
+        }
+        &'bearingd;completions'= {
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;simulate'= {
+            cand --model 'Which model makes the record'
+            cand --fault 'The defect'
+            cand --rpm 'Shaft speed, rpm'
+            cand --bearing 'Bearing: catalog name or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0"'
+            cand --duration 'Length of the record: seconds, e.g. 10 or 10s'
+            cand --fs 'Sample rate, Hz'
+            cand --out 'Output file: .csv (one column, g) or .wav (32-bit float, g)'
+            cand --load 'Physics model: radial load, N'
+            cand --defect-width 'Physics model: defect width, mm (CWRU: 0.178, 0.356, 0.533)'
+            cand --damping-ratio 'Physics model: damping ratio of the resonator (its resonance is --resonance)'
+            cand --dof 'Physics model: six degrees of freedom (seed 001) or five (seed 003)'
+            cand --calibrated 'Physics model: parameters saved by `bearingd calibrate --save` (JSON); they replace the structure (k_r, c_r, k_b, …), the defect width, the load and the model; --fault, --rpm, --fs, --duration, --noise, --jitter and --seed still apply'
+            cand --amplitude 'Signal model: impact amplitude a at full load, g'
+            cand --decay 'Signal model: decay rate B of each impact, 1/s'
+            cand --resonance 'Structural resonance f_n, Hz (physics model: the resonator''s, which sets k_r)'
+            cand --load-zone 'Signal model: Stribeck load-zone factor ε (0.5: half the bearing loaded)'
+            cand --jitter 'Impact-time jitter (slip), as a fraction of the impact period (physics model: the cage''s slip per ball pass)'
+            cand --defect-length 'Signal model: defect length in mm (0: one impact per passage; above: entry and exit impacts)'
+            cand --noise 'White noise, g (standard deviation)'
+            cand --machine-fault 'Signal model: add a fault of the machine (not of the bearing) at shaft orders'
+            cand --machine-fault-velocity 'RMS velocity of the machine fault''s 1× line, mm/s'
+            cand --onset 'Signal model: the fault appears at this time, s'
+            cand --seed 'Random seed: the same seed gives the same record'
+            cand --nuisance 'Signal model: add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md)'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
+        }
+        &'bearingd;dataset'= {
+            cand --spec 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml'
+            cand --out 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/'
+            cand --mcap 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;train'= {
+            cand --dataset 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes and bearing), e.g. a signal-model and a physics set'
+            cand --out 'The model file to write (.safetensors)'
+            cand --epochs 'Passes over the training segments'
+            cand --seed 'The seed of the initial weights, the corruption noise and the batch order'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;calibrate'= {
+            cand --channel 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)'
+            cand --column 'Column of a CSV table: header name or 1-based index'
+            cand --fs 'Sample rate in Hz (overrides what the file says)'
+            cand --rpm 'Shaft speed in rpm (overrides what the file says)'
+            cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
+            cand --fault 'The defect to model; default: the envelope diagnosis of the record'
+            cand --band 'The band compared, as LO-HI in Hz; default: the band the envelope analysis chose for the fault'
+            cand --load 'Radial load on the bearing, N'
+            cand --dof 'The model: six degrees of freedom (seed 001) or five (seed 003)'
+            cand --population 'Candidates per generation of the differential evolution'
+            cand --generations 'Generations of the differential evolution'
+            cand --simulated 'Seconds simulated per candidate'
+            cand --seed 'Seed of the search: the same seed gives the same calibration'
+            cand --plot 'Draw the measured, calibrated and default spectra to this file (.png or .svg)'
+            cand --save 'Write the calibrated parameters as JSON (for `simulate --model physics --calibrated`)'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
+        }
+        &'bearingd;evaluate'= {
+            cand --recordings 'Instead of the simulator: every record of this manifest (CSV with a header: `file` relative to its folder, and `fault`, `note` or `life_frac` for the truth; `channel_var`, `fs_hz`, `rpm`, `bearing_geometry` where the file does not say) through `bearingd analyze` and through `bearingd import` + `replay`; writes recordings.json. May be given several times'
+            cand --false-alarm-hours 'Instead of the sweep: H hours of healthy simulated signal per machine (the full sweep''s three machines at 0.6 and 1 × nominal speed, four noise levels, with the nuisance) streamed through the daemon''s channel monitor; counts the fault flags that rise (false alarms) per hour of operation; writes false_alarms.json and false_alarms.txt. Without a value: 2 h per machine (about 2.5 min of CPU)'
+            cand --out 'Directory for results.json, results.csv, table.txt and pd_vs_snr.svg (with --recordings: recordings.json and recordings.txt) (created)'
+            cand --seed 'Seed of the sweep: the same seed gives the same records and results'
+            cand --jobs 'Worker threads (default: the machine''s cores)'
+            cand --config 'Take the analysis and threshold settings from this config file instead of the embedded default (to evaluate a tuned configuration). With `twin.learned_model` the sweep''s record path also writes agreement_grid.txt (the learned model''s agreement decided at every point of a parameter grid); with --recordings only its agreement_* keys and model are used, by both paths'
+            cand --all-channels 'With --recordings: also the other channels of each record (CWRU fan end and base, every axis of other files; IMS snapshots are always evaluated on all eight)'
+            cand --strict 'With --recordings: exit 1 if any answer is confident and wrong, the paths disagree on any record, or any record fails (CI)'
+            cand --quick 'The small sweep CI runs (both bearings at nominal speed, default severity, the simulator''s default noise and 0 dB SNR, healthy records) instead of the full one'
+            cand --no-nuisance 'Leave out the machine''s nuisance (shaft harmonics, modulated noise, random impulses, gear and electrical tones): bearing, 1× tone and white noise only'
+            cand -h 'Print help'
+            cand --help 'Print help'
+        }
+        &'bearingd;trend'= {
+            cand --channel 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)'
+            cand --column 'Column of a CSV table: header name or 1-based index'
+            cand --fs 'Sample rate in Hz (overrides what the file says)'
+            cand --rpm 'Shaft speed in rpm (overrides what the file says)'
+            cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
+            cand --format 'Output format'
+            cand --plot 'Draw the stage timeline (RMS with the trend, kurtosis, HW residual, fault score) to this file (.png or .svg)'
+            cand --baseline 'Snapshots that form the healthy baseline (and the aging baseline of RMS)'
+            cand --smoothing 'Running median over this many snapshots before the tracker (1: none)'
+            cand --sigma 'Standard deviations above a baseline that change the stage'
+            cand --trend-window 'Snapshots in the sliding window of the RMS trend'
+            cand --threshold-g 'RMS threshold in g for the time-to-threshold (default: the failure limit the tracker learns at the start of degradation)'
+            cand --interval 'Seconds between snapshots whose names state no time (e.g. other .mcap files), placed in name order'
+            cand --window 'Records longer than 1.5 windows (IMS, MCAP logs) are cut into windows of this many seconds, each one snapshot'
+            cand --no-hw 'Do not identify the HW model per snapshot'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
+        }
+        &'bearingd;help'= {
+            cand analyze 'Diagnose a recording (CWRU .mat, PRONOSTIA/IMS/plain CSV, WAV) or the built-in demo'
+            cand run 'Run the service: sources → analysis → logs and alerts. Without --config, the embedded default: a simulated sensor that develops an outer-race fault after 30 s'
+            cand import 'Convert a recording (.mat, .csv, WAV) into a raw MCAP log and a config to replay it with'
+            cand replay 'Replay MCAP logs'' raw samples through the same pipeline, as fast as possible or at --speed'
+            cand validate 'Check a configuration file; lists every problem with its key and how to fix it'
+            cand ingest 'Run one source (SocketCAN or iceoryx2) alone and report what arrived'
+            cand alerts 'Print the daemon''s active alerts, then each alert as it comes (iceoryx2)'
+            cand fleet-decode 'Decode Sparkplug B messages of the fleet bridge: reads `TOPIC HEX` lines as printed by `mosquitto_sub -v -F ''%t %x'' -t ''spBv1.0/#''` and prints one JSON object per message'
+            cand config 'Configuration helpers'
+            cand completions 'Print the shell completion script for bash, zsh, fish, elvish or powershell on stdout (docs/OPERATIONS.md "Completions and man pages" says where each shell reads it)'
+            cand simulate 'Write a synthetic record of a bearing fault (signal model or physics twin) as CSV or WAV. Runs in bearingd-lab'
+            cand dataset 'Generate a labelled synthetic data set (signal model or physics twin) for learned diagnosis: NumPy .npz, a manifest, and optionally each record as an MCAP log. Runs in bearingd-lab'
+            cand train 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab'
+            cand calibrate 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab'
+            cand evaluate 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot. Runs in bearingd-lab'
+            cand trend 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab'
+            cand help 'Print this message or the help of the given subcommand(s)'
+        }
+        &'bearingd;help;analyze'= {
+        }
+        &'bearingd;help;run'= {
+        }
+        &'bearingd;help;import'= {
+        }
+        &'bearingd;help;replay'= {
+        }
+        &'bearingd;help;validate'= {
+        }
+        &'bearingd;help;ingest'= {
+        }
+        &'bearingd;help;alerts'= {
+        }
+        &'bearingd;help;fleet-decode'= {
+        }
+        &'bearingd;help;config'= {
+            cand default 'Print the documented default configuration (the embedded default: a simulated sensor)'
+        }
+        &'bearingd;help;config;default'= {
+        }
+        &'bearingd;help;completions'= {
+        }
+        &'bearingd;help;simulate'= {
+        }
+        &'bearingd;help;dataset'= {
+        }
+        &'bearingd;help;train'= {
+        }
+        &'bearingd;help;calibrate'= {
+        }
+        &'bearingd;help;evaluate'= {
+        }
+        &'bearingd;help;trend'= {
+        }
+        &'bearingd;help;help'= {
+        }
+    ]
+    $completions[$command]
+}
