@@ -7,6 +7,9 @@
 #                                     LAB_BIN=path/to/bearingd-lab likewise for the lab
 #   make install DESTDIR=/srv/root    stage into another root (packaging, VM images)
 #   make uninstall                    remove what install put there (not the config, logs, user)
+#   make cli-docs                     regenerate docs/cli (man pages, completion scripts) with the
+#                                     lab after a change of either command line; a test fails
+#                                     until they match (crates/bearingd-lab/tests/cli_docs.rs)
 #
 # What goes where (PREFIX=/usr by default):
 #   $(PREFIX)/bin/bearingd                         the service binary
@@ -15,6 +18,10 @@
 #   $(PREFIX)/lib/sysusers.d/bearingd.conf         the static system user and group `bearingd`
 #   $(PREFIX)/lib/tmpfiles.d/bearingd.conf         /dev/cpu_dma_latency writable by that group
 #   $(PREFIX)/share/doc/bearingd/SYSTEMD.md        the unit's Documentation=
+#   $(PREFIX)/share/man/man1/bearingd*.1           man pages of each program and command
+#                                                  (bearingd-lab*.1 not with install-service)
+#   $(PREFIX)/share/bash-completion/completions/bearingd, zsh/vendor-completions/_bearingd,
+#   $(PREFIX)/share/fish/vendor_completions.d/bearingd.fish   completions (and bearingd-lab's)
 #   /etc/bearingd/bearingd.toml                    the default config, never overwritten
 #
 # On a live system (no DESTDIR) install also creates the user (systemd-sysusers) and reloads
@@ -28,6 +35,10 @@ UNITDIR ?= $(PREFIX)/lib/systemd/system
 SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
 TMPFILESDIR ?= $(PREFIX)/lib/tmpfiles.d
 DOCDIR ?= $(PREFIX)/share/doc/bearingd
+MANDIR ?= $(PREFIX)/share/man/man1
+BASHCOMPDIR ?= $(PREFIX)/share/bash-completion/completions
+ZSHCOMPDIR ?= $(PREFIX)/share/zsh/vendor-completions
+FISHCOMPDIR ?= $(PREFIX)/share/fish/vendor_completions.d
 # The config path is fixed: the unit and the docs name /etc/bearingd/bearingd.toml.
 CONFDIR = /etc/bearingd
 CARGO ?= cargo
@@ -48,7 +59,13 @@ else
 LAB_BINARY := $(LAB_BIN)
 endif
 
-.PHONY: all build build-lab install install-service uninstall
+# Man pages and completion scripts are installed from the checkout (docs/cli, written by the
+# lab: `make cli-docs`), so that install-service and BIN= (a cross-built binary that cannot run
+# here) need no lab and run nothing they install.
+LAB_MANS := $(wildcard docs/cli/man/bearingd-lab.1 docs/cli/man/bearingd-lab-*.1)
+SERVICE_MANS := $(filter-out $(LAB_MANS),$(wildcard docs/cli/man/bearingd*.1))
+
+.PHONY: all build build-lab install install-service uninstall cli-docs
 
 all: build build-lab
 
@@ -69,6 +86,10 @@ endif
 # Both binaries: `bearingd evaluate ...` and the other lab commands run bearingd-lab.
 install: install-service build-lab
 	$(INSTALL) -D -m 0755 "$(LAB_BINARY)" "$(DESTDIR)$(BINDIR)/bearingd-lab"
+	$(INSTALL) -m 0644 $(LAB_MANS) "$(DESTDIR)$(MANDIR)/"
+	$(INSTALL) -D -m 0644 docs/cli/completions/bearingd-lab "$(DESTDIR)$(BASHCOMPDIR)/bearingd-lab"
+	$(INSTALL) -D -m 0644 docs/cli/completions/_bearingd-lab "$(DESTDIR)$(ZSHCOMPDIR)/_bearingd-lab"
+	$(INSTALL) -D -m 0644 docs/cli/completions/bearingd-lab.fish "$(DESTDIR)$(FISHCOMPDIR)/bearingd-lab.fish"
 
 install-service: build
 	$(INSTALL) -D -m 0755 "$(BINARY)" "$(DESTDIR)$(BINDIR)/bearingd"
@@ -80,6 +101,11 @@ install-service: build
 	$(INSTALL) -D -m 0644 systemd/bearingd.sysusers "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf"
 	$(INSTALL) -D -m 0644 systemd/bearingd.tmpfiles "$(DESTDIR)$(TMPFILESDIR)/bearingd.conf"
 	$(INSTALL) -D -m 0644 docs/SYSTEMD.md "$(DESTDIR)$(DOCDIR)/SYSTEMD.md"
+	$(INSTALL) -d -m 0755 "$(DESTDIR)$(MANDIR)"
+	$(INSTALL) -m 0644 $(SERVICE_MANS) "$(DESTDIR)$(MANDIR)/"
+	$(INSTALL) -D -m 0644 docs/cli/completions/bearingd "$(DESTDIR)$(BASHCOMPDIR)/bearingd"
+	$(INSTALL) -D -m 0644 docs/cli/completions/_bearingd "$(DESTDIR)$(ZSHCOMPDIR)/_bearingd"
+	$(INSTALL) -D -m 0644 docs/cli/completions/bearingd.fish "$(DESTDIR)$(FISHCOMPDIR)/bearingd.fish"
 	$(INSTALL) -d -m 0755 "$(DESTDIR)$(CONFDIR)"
 	@if [ -e "$(DESTDIR)$(CONFDIR)/bearingd.toml" ]; then \
 	  echo "kept the existing $(DESTDIR)$(CONFDIR)/bearingd.toml (the default is in $(DOCDIR) as bearingd.toml.default)"; \
@@ -103,6 +129,17 @@ uninstall:
 	      "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf" "$(DESTDIR)$(TMPFILESDIR)/bearingd.conf" \
 	      "$(DESTDIR)$(DOCDIR)/SYSTEMD.md" \
 	      "$(DESTDIR)$(DOCDIR)/bearingd.toml.default"
+	rm -f "$(DESTDIR)$(MANDIR)"/bearingd.1 "$(DESTDIR)$(MANDIR)"/bearingd-*.1
+	rm -f "$(DESTDIR)$(BASHCOMPDIR)/bearingd" "$(DESTDIR)$(BASHCOMPDIR)/bearingd-lab" \
+	      "$(DESTDIR)$(ZSHCOMPDIR)/_bearingd" "$(DESTDIR)$(ZSHCOMPDIR)/_bearingd-lab" \
+	      "$(DESTDIR)$(FISHCOMPDIR)/bearingd.fish" "$(DESTDIR)$(FISHCOMPDIR)/bearingd-lab.fish"
 	rmdir "$(DESTDIR)$(DOCDIR)" 2>/dev/null || true
 	@if [ -z "$(DESTDIR)" ] && [ -d /run/systemd/system ]; then systemctl daemon-reload; fi
 	@echo "left in place: $(CONFDIR) (your config), /var/lib/bearingd, /var/log/bearingd (data) and the bearingd user"
+
+# docs/cli from the current command lines (the service embeds docs/cli/completions: rebuild it
+# after this). Stale pages of removed commands go first.
+cli-docs: build-lab
+	rm -f docs/cli/man/*.1
+	"$(LAB_BINARY)" man --out docs/cli/man
+	"$(LAB_BINARY)" completions --out docs/cli/completions

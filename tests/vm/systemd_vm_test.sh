@@ -82,7 +82,10 @@ check_installed() {
   if [ ! -e "$R$1" ]; then install_ok=FAIL; install_detail+=" missing $1;"; fi
 }
 for f in /usr/bin/bearingd /usr/lib/systemd/system/bearingd.service \
-  /usr/lib/sysusers.d/bearingd.conf /usr/lib/tmpfiles.d/bearingd.conf /usr/share/doc/bearingd/SYSTEMD.md /etc/bearingd/bearingd.toml; do
+  /usr/lib/sysusers.d/bearingd.conf /usr/lib/tmpfiles.d/bearingd.conf /usr/share/doc/bearingd/SYSTEMD.md /etc/bearingd/bearingd.toml \
+  /usr/share/man/man1/bearingd.1 /usr/share/man/man1/bearingd-run.1 \
+  /usr/share/bash-completion/completions/bearingd /usr/share/zsh/vendor-completions/_bearingd \
+  /usr/share/fish/vendor_completions.d/bearingd.fish; do
   check_installed "$f"
 done
 cmp -s "$ROOT/config/bearingd.toml" "$R/etc/bearingd/bearingd.toml" ||
@@ -124,7 +127,7 @@ install -m 0644 "$WORK/test.toml" "$R/etc/bearingd/bearingd.toml"
 make -s -C "$ROOT" install-service DESTDIR="$R" BIN="$WORK/bearingd" >> "$WORK/install.log"
 cmp -s "$WORK/test.toml" "$R/etc/bearingd/bearingd.toml" ||
   { install_ok=FAIL; install_detail+=" a second make install overwrote /etc/bearingd/bearingd.toml;"; }
-echo "VMTEST install: $install_ok ${install_detail:-binary, unit, sysusers.d, doc, config in place; config kept on re-install; user $(cat "$WORK/passwd.line" 2>/dev/null)}" \
+echo "VMTEST install: $install_ok ${install_detail:-binary, unit, sysusers.d, doc, man pages, completions, config in place; config kept on re-install; user $(cat "$WORK/passwd.line" 2>/dev/null)}" \
   | tee "$WORK/host-verdicts.log"
 
 # The probe: a oneshot unit after bearingd that reports on ttyS0 and powers the VM off.

@@ -1,11 +1,13 @@
 //! The man pages and completion scripts of both command lines (`bearingd-lab man`,
-//! `bearingd-lab completions`), and the committed copies in docs/cli that the service embeds.
+//! `bearingd-lab completions`), the committed copies in docs/cli that the service embeds and
+//! `make install` installs, and that install itself into a DESTDIR.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::cli::completions::Shell;
 use bearingd_lab::cli::docs::{completion_script, man_pages, Program};
-use bearingd_testdata::{run_binary, scratch_dir};
+use bearingd_testdata::{binary_beside, run_binary, scratch_dir};
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 const LAB: &str = env!("CARGO_BIN_EXE_bearingd-lab");
 
@@ -144,6 +146,76 @@ fn committed_docs_are_up_to_date() {
             shell.script().as_bytes(),
             completion_script(Program::Bearingd, shell),
             "the service's embedded {shell:?} script is stale: {fix}"
+        );
+    }
+}
+
+/// `make install` into a DESTDIR puts both programs' pages and scripts where man, bash, zsh and
+/// fish look; `make install-service` the service's alone; `make uninstall` takes them away.
+#[test]
+fn make_install_puts_pages_and_completions_under_destdir() {
+    let service = binary_beside(LAB, "bearingd");
+    let make = |target: &str, root: &Path| {
+        let out = Command::new("make")
+            .arg("-s")
+            .arg("-C")
+            .arg(repo_root())
+            .arg(target)
+            .arg(format!("DESTDIR={}", root.display()))
+            .arg(format!("BIN={}", service.display()))
+            .arg(format!("LAB_BIN={LAB}"))
+            .output()
+            .expect("cannot run make: apt-get install make");
+        assert!(out.status.success(), "make {target}: {}", stderr(&out));
+    };
+    let share = |root: &Path, rel: &str| root.join("usr/share").join(rel);
+    let service_files = [
+        "man/man1/bearingd.1",
+        "man/man1/bearingd-run.1",
+        "man/man1/bearingd-config-default.1",
+        "bash-completion/completions/bearingd",
+        "zsh/vendor-completions/_bearingd",
+        "fish/vendor_completions.d/bearingd.fish",
+    ];
+    let lab_files = [
+        "man/man1/bearingd-lab.1",
+        "man/man1/bearingd-lab-train.1",
+        "bash-completion/completions/bearingd-lab",
+        "zsh/vendor-completions/_bearingd-lab",
+        "fish/vendor_completions.d/bearingd-lab.fish",
+    ];
+
+    let root = scratch_dir("cli-docs-install");
+    make("install", &root);
+    for rel in service_files.iter().chain(&lab_files) {
+        assert!(share(&root, rel).is_file(), "make install left out {rel}");
+    }
+    let bash = std::fs::read(share(&root, "bash-completion/completions/bearingd")).unwrap();
+    assert_eq!(bash, Shell::Bash.script().as_bytes());
+    let pages = std::fs::read_dir(share(&root, "man/man1")).unwrap().count();
+    assert_eq!(
+        pages,
+        std::fs::read_dir(repo_root().join("docs/cli/man"))
+            .unwrap()
+            .count()
+    );
+    make("uninstall", &root);
+    for rel in service_files.iter().chain(&lab_files) {
+        assert!(!share(&root, rel).exists(), "make uninstall left {rel}");
+    }
+
+    let root = scratch_dir("cli-docs-install-service");
+    make("install-service", &root);
+    for rel in service_files {
+        assert!(
+            share(&root, rel).is_file(),
+            "make install-service left out {rel}"
+        );
+    }
+    for rel in lab_files {
+        assert!(
+            !share(&root, rel).exists(),
+            "install-service installed {rel}"
         );
     }
 }
