@@ -61,7 +61,7 @@ pub use types::{
     Broker, CanConfig, Config, FleetConfig, OutputConfig, SensorConfig, ShmConfig, SimConfig,
     SimFault, Speed, ThresholdConfig, Transport, TwinConfig,
 };
-pub use validate::{MAX_ID_LEN, MAX_IOX_ROOT_LEN};
+pub use validate::{MAX_ID_LEN, MAX_IOX_ROOT_LEN, TLS_BUILT, TLS_NOT_BUILT};
 
 /// The embedded default configuration: one simulated sensor on an SKF 6205-2RS at 1772 rpm,
 /// sampled at 25.6 kHz, whose outer race develops a fault after 30 s. Also the documented

@@ -128,3 +128,26 @@ fn an_iceoryx2_root_too_long_for_its_sockets_is_refused() {
         .unwrap_or_else(|| panic!("{problems:?}"));
     assert!(problem.message.contains("108 bytes"), "{}", problem.message);
 }
+
+#[test]
+fn an_mqtts_broker_is_used_with_the_tls_feature_and_a_problem_naming_it_without() {
+    let fleet = format!(
+        "{SENSOR}[fleet]\nenabled = true\nbroker = \"mqtts://broker.plant\"\nnode_id = \"press-7\"\n"
+    );
+    if config::TLS_BUILT {
+        let broker = config_of(&fleet).fleet.map(|f| f.broker.to_string());
+        assert_eq!(broker.as_deref(), Some("mqtts://broker.plant:8883"));
+    } else {
+        let found = problems(&fleet);
+        assert_eq!(keys(&found), ["fleet.broker"], "{found:#?}");
+        assert!(
+            found[0].message.contains("cargo feature `tls`"),
+            "{}",
+            found[0]
+        );
+        found.iter().for_each(assert_has_fix);
+    }
+    let plain = fleet.replace("mqtts://", "mqtt://");
+    let broker = config_of(&plain).fleet.map(|f| f.broker.to_string());
+    assert_eq!(broker.as_deref(), Some("mqtt://broker.plant:1883"));
+}

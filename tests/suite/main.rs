@@ -9,6 +9,8 @@ mod dataset;
 mod defect_size;
 mod developer_set;
 mod envelope;
+// Against a real mosquitto over TLS (mqtts://): needs the `tls` feature (a default one).
+#[cfg(feature = "tls")]
 mod fleet;
 mod formats;
 mod hostile_alerts;

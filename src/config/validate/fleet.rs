@@ -33,6 +33,15 @@ impl FleetConfig {
 }
 
 pub(crate) const DEFAULT_BROKER: &str = "mqtt://localhost:1883";
+
+/// Whether this build can speak TLS to a broker (the `tls` cargo feature, on by default).
+pub const TLS_BUILT: bool = cfg!(feature = "tls");
+
+/// Why an `mqtts://` broker cannot be used by a build without the `tls` feature, and the fix.
+pub const TLS_NOT_BUILT: &str = "this bearingd was built without TLS (the cargo feature `tls`, \
+     on by default, was left out); use a bearingd built with it (`cargo build --profile service \
+     -p bearingd --locked --features tls`) or a plain mqtt:// broker";
+
 const DEFAULT_GROUP: &str = "bearingd";
 const DEFAULT_PERIOD_S: f64 = 1.0;
 const DEFAULT_KEEP_ALIVE_S: f64 = 30.0;
@@ -60,7 +69,7 @@ impl Checker {
                 "give the broker as mqtt://HOST:PORT or mqtts://HOST:PORT, e.g. broker = \
                  \"mqtts://broker.plant:8883\"",
             )
-            .and_then(|text| self.broker(&text));
+            .and_then(|text| self.broker(&text, TLS_BUILT));
         let group_id = self.sparkplug_id("fleet.group_id", &raw.group_id, Some(DEFAULT_GROUP));
         let node_id = if enabled {
             self.sparkplug_id("fleet.node_id", &raw.node_id, None)
@@ -222,7 +231,9 @@ impl Checker {
         .filter(|_| consistent)
     }
 
-    fn broker(&mut self, text: &str) -> Option<Broker> {
+    /// `tls_built`: whether `mqtts://` can be served ([`TLS_BUILT`]; a parameter so that the
+    /// tests see both builds' answers).
+    fn broker(&mut self, text: &str, tls_built: bool) -> Option<Broker> {
         let key = "fleet.broker";
         let fix = "give it as mqtt://HOST:PORT or mqtts://HOST:PORT, e.g. broker = \
                    \"mqtts://broker.plant:8883\"";
@@ -237,6 +248,13 @@ impl Checker {
             );
             return None;
         };
+        if tls && !tls_built {
+            self.problem(
+                key,
+                format!("{text:?} is a TLS broker, but {TLS_NOT_BUILT}"),
+            );
+            return None;
+        }
         let default_port = if tls { 8883 } else { 1883 };
         let rest = rest.trim_end_matches('/');
         let (host, port) = match rest.rsplit_once(':') {
@@ -342,5 +360,38 @@ impl Checker {
             self.problem(key, format!("{}: no such file; {fix}", path.display()));
             None
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_mqtts_broker_without_the_tls_feature_is_a_problem_naming_the_feature_and_the_build() {
+        let mut check = Checker::default();
+        assert_eq!(check.broker("mqtts://broker.plant:8883", false), None);
+        assert_eq!(check.problems.len(), 1);
+        let problem = check.problems[0].to_string();
+        assert!(problem.contains("fleet.broker"), "{problem}");
+        assert!(
+            problem.contains("\"mqtts://broker.plant:8883\" is a TLS broker"),
+            "{problem}"
+        );
+        assert!(problem.contains("cargo feature `tls`"), "{problem}");
+        assert!(problem.contains("--features tls"), "{problem}");
+
+        let mut check = Checker::default();
+        let plain = check.broker("mqtt://broker.plant", false);
+        assert_eq!(plain.map(|b| (b.tls, b.port)), Some((false, 1883)));
+        assert!(check.problems.is_empty());
+    }
+
+    #[test]
+    fn an_mqtts_broker_with_the_tls_feature_is_tls_on_8883() {
+        let mut check = Checker::default();
+        let broker = check.broker("mqtts://broker.plant", true);
+        assert_eq!(broker.map(|b| (b.tls, b.port)), Some((true, 8883)));
+        assert!(check.problems.is_empty());
     }
 }

@@ -31,6 +31,8 @@ use super::types::{
     DEFAULT_SCALE_G_PER_COUNT, DEFAULT_SPEED_SEARCH,
 };
 
+pub use fleet::{TLS_BUILT, TLS_NOT_BUILT};
+
 /// Longest sensor id, in characters.
 pub const MAX_ID_LEN: usize = 32;
 /// Longest iceoryx2 root we accept, in bytes. iceoryx2 0.10 puts a subscriber's event

@@ -1,5 +1,6 @@
 //! The bridge's I/O: one thread with its own single-threaded tokio runtime, an MQTT 5 client
-//! (rumqttc) over TCP or TLS (rustls), the disk queue, and the edge node's session.
+//! (rumqttc) over TCP or TLS (rustls, with the `tls` feature), the disk queue, and the edge
+//! node's session.
 //!
 //! Why a thread of its own: the daemon's sink thread must never wait on a network, and the
 //! queue's fsyncs must not run on the daemon's tokio workers. The sink hands observations over
@@ -198,16 +199,28 @@ fn mqtt_options(config: &FleetConfig) -> Result<MqttOptions, BridgeError> {
         options.set_credentials(user.clone(), password);
     }
     if config.broker.tls {
-        let tls = tls_config(config)?;
-        options.set_transport(rumqttc::Transport::tls_with_config(
-            rumqttc::TlsConfiguration::Rustls(Arc::new(tls)),
-        ));
+        #[cfg(feature = "tls")]
+        {
+            let tls = tls_config(config)?;
+            options.set_transport(rumqttc::Transport::tls_with_config(
+                rumqttc::TlsConfiguration::Rustls(Arc::new(tls)),
+            ));
+        }
+        // The config's check says so first (`fleet.broker`); a FleetConfig built in code
+        // without it still stops here rather than speaking plain MQTT to a TLS port.
+        #[cfg(not(feature = "tls"))]
+        return Err(BridgeError::Tls {
+            key: "broker",
+            path: PathBuf::from(config.broker.to_string()),
+            problem: crate::config::TLS_NOT_BUILT.into(),
+        });
     }
     Ok(options)
 }
 
 /// rustls with the ring provider: the CA file's certificates (or the system's roots), and the
 /// client certificate when configured.
+#[cfg(feature = "tls")]
 fn tls_config(config: &FleetConfig) -> Result<rustls::ClientConfig, BridgeError> {
     use rustls::pki_types::pem::PemObject;
     use rustls::pki_types::{CertificateDer, PrivateKeyDer};
@@ -491,6 +504,7 @@ impl Bridge {
         let why = match &error {
             Some(ConnectionError::ConnectionRefused(code)) => refusal(*code, &self.config),
             Some(ConnectionError::Io(e)) => format!("cannot reach it: {e}"),
+            #[cfg(feature = "tls")]
             Some(ConnectionError::Tls(e)) => format!(
                 "TLS failed: {e}; check fleet.ca_file (the CA that signed the broker's \
                  certificate) and that the broker's certificate names {}",
