@@ -23,10 +23,11 @@ fn learned(c: &mut Criterion) {
     let params = SimulationParams::example(SimulatedFault::OuterRace);
     let record = Simulator::record(params.clone(), 10.0);
     let shaft_hz = params.rpm / 60.0;
+    let freqs = params.bearing.fault_frequencies(shaft_hz);
     let features = model.card.features;
     let segment = features.segment_samples(params.fs_hz, shaft_hz);
     let mut plans = FftPlans::default();
-    let input = features.order_spectrum(&mut plans, &record[..segment], params.fs_hz, shaft_hz);
+    let input = features.order_spectrum(&mut plans, &record[..segment], params.fs_hz, &freqs);
     c.bench_function(
         "learned: input of one segment (24 revolutions, 12 kHz)",
         |b| {
@@ -35,7 +36,7 @@ fn learned(c: &mut Criterion) {
                     &mut plans,
                     black_box(&record[..segment]),
                     params.fs_hz,
-                    shaft_hz,
+                    &freqs,
                 )
             })
         },

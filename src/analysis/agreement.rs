@@ -14,7 +14,7 @@
 
 use super::diagnosis::{Contest, DecisionRule, Diagnosis, Named, LONE_HARMONIC_RATIO};
 use super::fault_bands::FaultScore;
-use crate::bearing::BearingGeometry;
+use crate::bearing::{BearingGeometry, FaultFrequencies};
 use crate::messages::FaultKind;
 use serde::{Deserialize, Serialize};
 
@@ -57,13 +57,14 @@ pub struct WitnessOpinion {
 
 /// A second opinion of a signal, e.g. the learned model (`crate::learned::LearnedModel`).
 pub trait Witness: Send + Sync + std::fmt::Debug {
-    /// The opinion of `signal` (g, at `fs_hz`, shaft at `shaft_hz`); `Ok(None)` when it has
-    /// none (the signal is too short for it), `Err` with why when it failed.
+    /// The opinion of `signal` (g, at `fs_hz`, the shaft and the faults at `freqs`);
+    /// `Ok(None)` when it has none (the signal is too short for it), `Err` with why when it
+    /// failed.
     fn witness(
         &self,
         signal: &[f32],
         fs_hz: f64,
-        shaft_hz: f64,
+        freqs: &FaultFrequencies,
     ) -> Result<Option<WitnessOpinion>, String>;
 
     /// Whether it can judge signals of `bearing` (a model is trained for one geometry).

@@ -181,7 +181,7 @@ impl BandJob {
         }
         let mut analysis =
             analyze_with_plans(plans, &signal, self.fs_hz, &freqs, &self.analysis).ok();
-        let witness = self.hear_witness(analysis.as_mut(), &signal, freqs.shaft);
+        let witness = self.hear_witness(analysis.as_mut(), &signal, &freqs);
         let evidence = analysis.as_ref().map(|analysis| Evidence {
             scores: FaultKind::ALL.map(|kind| {
                 analysis
@@ -222,14 +222,14 @@ impl BandJob {
         &self,
         analysis: Option<&mut RecordAnalysis>,
         signal: &[f32],
-        shaft_hz: f64,
+        freqs: &FaultFrequencies,
     ) -> Option<WitnessHeard> {
         let (Some(analysis), Some(witness), Some(_)) =
             (analysis, &self.witness, self.analysis.agreement)
         else {
             return None;
         };
-        let heard = match witness.witness(signal, self.fs_hz, shaft_hz) {
+        let heard = match witness.witness(signal, self.fs_hz, freqs) {
             Ok(Some(opinion)) => WitnessHeard::Opinion(opinion),
             Ok(None) => WitnessHeard::Silent,
             Err(_) => WitnessHeard::Failed,

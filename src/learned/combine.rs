@@ -9,7 +9,7 @@
 use super::model::{LearnedModel, LearnedOpinion};
 use crate::analysis::agreement::{Witness, WitnessOpinion};
 use crate::analysis::diagnosis::{Diagnosis, Named, Verdict};
-use crate::bearing::BearingGeometry;
+use crate::bearing::{BearingGeometry, FaultFrequencies};
 use serde::Serialize;
 
 impl LearnedOpinion {
@@ -30,9 +30,9 @@ impl Witness for LearnedModel {
         &self,
         signal: &[f32],
         fs_hz: f64,
-        shaft_hz: f64,
+        freqs: &FaultFrequencies,
     ) -> Result<Option<WitnessOpinion>, String> {
-        self.opinion_of_checked(signal, fs_hz, shaft_hz)
+        self.opinion_of_checked(signal, fs_hz, freqs)
             .map(|opinion| opinion.as_witness())
             .map_err(|e| e.to_string())
     }

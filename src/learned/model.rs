@@ -9,7 +9,7 @@ use super::features::FeatureSettings;
 use super::file::{FileError, ModelFile};
 use super::infer::{Scratch, Weights};
 use crate::analysis::envelope::FftPlans;
-use crate::bearing::BearingGeometry;
+use crate::bearing::{BearingGeometry, FaultFrequencies};
 use crate::twin::SimulatedFault;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -25,7 +25,8 @@ pub struct ModelCard {
     pub format: u32,
     /// The classes, in output order.
     pub classes: Vec<SimulatedFault>,
-    /// The bearing the training set simulated (its fault orders are what the model knows).
+    /// The bearing the training set simulated (its fault orders are what the model knows); for
+    /// a model on fault-relative orders, the bearings it was trained on (it serves any).
     pub bearing: String,
     pub features: FeatureSettings,
     pub training: TrainingSummary,
@@ -151,6 +152,9 @@ impl LearnedModel {
                 card.format
             )));
         }
+        if let Some(why) = card.features.problem() {
+            return Err(not_a_model(why));
+        }
         Self::from_tensors(card, file.clone(), |name, shape| {
             model_file.tensor(name, shape)
         })
@@ -185,22 +189,23 @@ impl LearnedModel {
         bearing: &BearingGeometry,
     ) -> Result<LearnedOpinion, ModelError> {
         self.check_bearing(bearing)?;
-        self.opinion_of_checked(samples, fs_hz, shaft_hz)
+        self.opinion_of_checked(samples, fs_hz, &bearing.fault_frequencies(shaft_hz))
     }
 
     /// [`Self::opinion`] for a caller that has checked the bearing once with
     /// [`Self::check_bearing`] (the daemon, at its config's validation).
+    /// `freqs`: the shaft's and the faults' frequencies (Hz) of the record's bearing.
     pub fn opinion_of_checked(
         &self,
         samples: &[f32],
         fs_hz: f64,
-        shaft_hz: f64,
+        freqs: &FaultFrequencies,
     ) -> Result<LearnedOpinion, ModelError> {
         let mut plans = FftPlans::default();
         let inputs = self
             .card
             .features
-            .record_inputs(&mut plans, samples, fs_hz, shaft_hz);
+            .record_inputs(&mut plans, samples, fs_hz, freqs);
         let segments = inputs.len() / self.weights.bins();
         let mut mean = vec![0f64; self.card.classes.len()];
         self.for_each_segment(&inputs, |probabilities| {
@@ -219,8 +224,12 @@ impl LearnedModel {
     }
 
     /// The record's bearing must have the fault orders the model was trained on (the same
-    /// geometry; its name may differ).
+    /// geometry; its name may differ), unless the model reads fault-relative orders: then any
+    /// geometry will do.
     pub fn check_bearing(&self, bearing: &BearingGeometry) -> Result<(), ModelError> {
+        if !self.card.features.axis.is_shaft() {
+            return Ok(());
+        }
         let trained =
             BearingGeometry::parse(&self.card.bearing).map_err(|e| ModelError::NotAModel {
                 file: self.file.clone(),

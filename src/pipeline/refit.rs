@@ -157,7 +157,7 @@ impl TwinWorker {
     fn learned_opinion(&self, request: &TwinRequest) -> Option<LearnedOpinionMessage> {
         let model = self.learned.as_ref()?;
         let opinion =
-            match model.opinion_of_checked(&request.samples, request.fs_hz, request.freqs.shaft) {
+            match model.opinion_of_checked(&request.samples, request.fs_hz, &request.freqs) {
                 Ok(opinion) if opinion.segments > 0 => opinion,
                 Ok(_) => return None,
                 Err(e) => {

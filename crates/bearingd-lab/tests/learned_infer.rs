@@ -5,6 +5,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::envelope::FftPlans;
+use bearingd::bearing::BearingGeometry;
 use bearingd::learned::LearnedModel;
 use bearingd::recording::{read_recording, ReadOptions};
 use bearingd::twin::{SimulatedFault, SimulationParams, Simulator};
@@ -36,7 +37,10 @@ impl Both {
     fn compare(&self, what: &str, samples: &[f32], fs_hz: f64, shaft_hz: f64) -> usize {
         let features = self.plain.card.features;
         let bins = features.order_bins;
-        let inputs = features.record_inputs(&mut FftPlans::default(), samples, fs_hz, shaft_hz);
+        let freqs = BearingGeometry::parse(&self.plain.card.bearing)
+            .unwrap()
+            .fault_frequencies(shaft_hz);
+        let inputs = features.record_inputs(&mut FftPlans::default(), samples, fs_hz, &freqs);
         let segments = inputs.len() / bins;
         assert!(segments > 0, "{what}: no whole segment");
         let plain = self.plain.classify(&inputs);

@@ -188,7 +188,7 @@ pub fn run_case(
                 return record_outcome(&analysis.diagnosis, &analysis);
             };
             let opinion = witness
-                .witness(&signal[..record_len], fs, freqs.shaft)
+                .witness(&signal[..record_len], fs, &freqs)
                 .ok()
                 .flatten();
             let grid = grid_verdicts(&analysis, bench.analysis(), opinion);
