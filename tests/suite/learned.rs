@@ -83,6 +83,68 @@ fn a_tiny_training_run_learns_to_tell_faults_apart() {
     }
 }
 
+#[test]
+fn a_model_on_fault_relative_orders_trained_on_random_bearings_judges_a_bearing_it_never_saw() {
+    let dir = scratch_dir("learned-any");
+    let spec = TINY_SPEC
+        .replace("bearing = \"skf-6205-2rs\"", "bearing = \"random\"")
+        .replace("records_per_fault = 20", "records_per_fault = 40");
+    let set = make(&dir, "any", &spec, false);
+    let model_path = dir.join("any.safetensors");
+    let train = |axis: &str| {
+        bearingd(&[
+            "train",
+            "--dataset",
+            set.to_str().unwrap(),
+            "--out",
+            model_path.to_str().unwrap(),
+            "--epochs",
+            "16",
+            "--axis",
+            axis,
+        ])
+    };
+    let refused = train("shaft");
+    let log = stderr(&refused);
+    assert_eq!(refused.status.code(), Some(2), "{log}");
+    assert!(
+        log.contains("bearing = \"random\"") && log.contains("--axis fault-relative"),
+        "the error names the cause and the fix: {log}"
+    );
+    let trained = train("fault-relative");
+    let log = stderr(&trained);
+    assert!(trained.status.success(), "{log}");
+    let model = LearnedModel::load(&model_path).unwrap();
+    assert!(
+        model.card.bearing.starts_with("any"),
+        "{}",
+        model.card.bearing
+    );
+    // Bearings of the catalog, none of them drawn in training (their geometries are rounded
+    // otherwise), each on records of another seed and speed.
+    for bearing in ["rexnord-za-2115", "skf-61804"] {
+        let geometry = bearingd::bearing::BearingGeometry::parse(bearing).unwrap();
+        for fault in [
+            SimulatedFault::OuterRace,
+            SimulatedFault::InnerRace,
+            SimulatedFault::None,
+        ] {
+            let params = SimulationParams {
+                rpm: 1650.0,
+                seed: 99,
+                bearing: geometry.clone(),
+                ..SimulationParams::example(fault)
+            };
+            let samples = Simulator::record(params.clone(), 3.0);
+            let opinion = model
+                .opinion(&samples, params.fs_hz, params.rpm / 60.0, &params.bearing)
+                .unwrap();
+            assert!(opinion.segments >= 3, "{opinion:?}");
+            assert_eq!(opinion.top().0, fault, "{bearing}: {opinion:?}");
+        }
+    }
+}
+
 fn shipped_model() -> Arc<LearnedModel> {
     Arc::new(LearnedModel::load(&repo_root().join("models/skf-6205-2rs.safetensors")).unwrap())
 }

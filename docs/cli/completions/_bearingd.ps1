@@ -212,10 +212,11 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             break
         }
         'bearingd;train' {
-            [CompletionResult]::new('--dataset', '--dataset', [CompletionResultType]::ParameterName, 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes and bearing), e.g. a signal-model and a physics set')
+            [CompletionResult]::new('--dataset', '--dataset', [CompletionResultType]::ParameterName, 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes, and same bearing on shaft orders), e.g. a signal-model and a physics set')
             [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'The model file to write (.safetensors)')
             [CompletionResult]::new('--epochs', '--epochs', [CompletionResultType]::ParameterName, 'Passes over the training segments')
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'The seed of the initial weights, the corruption noise and the batch order')
+            [CompletionResult]::new('--axis', '--axis', [CompletionResultType]::ParameterName, 'The input''s axis: `shaft` orders (the model knows the data set''s one bearing) or `fault-relative` orders (each fault''s own; the model serves any bearing, best trained on data sets of many, e.g. `bearing = "random"`)')
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
             [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
             break

@@ -192,10 +192,11 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --help 'Print help'
         }
         &'bearingd;train'= {
-            cand --dataset 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes and bearing), e.g. a signal-model and a physics set'
+            cand --dataset 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes, and same bearing on shaft orders), e.g. a signal-model and a physics set'
             cand --out 'The model file to write (.safetensors)'
             cand --epochs 'Passes over the training segments'
             cand --seed 'The seed of the initial weights, the corruption noise and the batch order'
+            cand --axis 'The input''s axis: `shaft` orders (the model knows the data set''s one bearing) or `fault-relative` orders (each fault''s own; the model serves any bearing, best trained on data sets of many, e.g. `bearing = "random"`)'
             cand -h 'Print help'
             cand --help 'Print help'
         }

@@ -163,10 +163,12 @@ complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -l spec -d 'T
 complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -l out -d 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/' -r -F
 complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -l mcap -d 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config'
 complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -s h -l help -d 'Print help'
-complete -c bearingd -n "__fish_bearingd_using_subcommand train" -l dataset -d 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes and bearing), e.g. a signal-model and a physics set' -r -F
+complete -c bearingd -n "__fish_bearingd_using_subcommand train" -l dataset -d 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes, and same bearing on shaft orders), e.g. a signal-model and a physics set' -r -F
 complete -c bearingd -n "__fish_bearingd_using_subcommand train" -l out -d 'The model file to write (.safetensors)' -r -F
 complete -c bearingd -n "__fish_bearingd_using_subcommand train" -l epochs -d 'Passes over the training segments' -r
 complete -c bearingd -n "__fish_bearingd_using_subcommand train" -l seed -d 'The seed of the initial weights, the corruption noise and the batch order' -r
+complete -c bearingd -n "__fish_bearingd_using_subcommand train" -l axis -d 'The input\'s axis: `shaft` orders (the model knows the data set\'s one bearing) or `fault-relative` orders (each fault\'s own; the model serves any bearing, best trained on data sets of many, e.g. `bearing = "random"`)' -r -f -a "shaft\t''
+fault-relative\t''"
 complete -c bearingd -n "__fish_bearingd_using_subcommand train" -s h -l help -d 'Print help'
 complete -c bearingd -n "__fish_bearingd_using_subcommand calibrate" -l channel -d 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)' -r
 complete -c bearingd -n "__fish_bearingd_using_subcommand calibrate" -l column -d 'Column of a CSV table: header name or 1-based index' -r

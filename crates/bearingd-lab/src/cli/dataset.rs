@@ -5,7 +5,6 @@
 //! that `bearingd replay` reads as the daemon's own. Records are made on all cores, with a
 //! progress bar on a terminal.
 
-use crate::bearing::BearingGeometry;
 use crate::sinks::mcap::raw_log::{write_raw_log, LogSignal, RawLog};
 use crate::twin::dataset::{DatasetRecord, DatasetSpec};
 use bearingd::cli::import::raw_log_error;
@@ -147,13 +146,13 @@ fn write_manifest(path: &Path, records: &[DatasetRecord], mcap: bool) -> Result<
     let mut out = std::io::BufWriter::new(file);
     writeln!(
         out,
-        "index,label,fault,model,rpm,noise_g,severity,load_n,resonance_hz,seed,mcap"
+        "index,label,fault,model,rpm,noise_g,severity,load_n,resonance_hz,seed,mcap,bearing"
     )
     .map_err(fail)?;
     for r in records {
         writeln!(
             out,
-            "{},{},{},{},{:.3},{:.5},{:.5},{:.1},{:.1},{},{}",
+            "{},{},{},{},{:.3},{:.5},{:.5},{:.1},{:.1},{},{},\"{}\"",
             r.index,
             r.label,
             r.fault.name(),
@@ -168,7 +167,8 @@ fn write_manifest(path: &Path, records: &[DatasetRecord], mcap: bool) -> Result<
                 log_dir(r).display().to_string()
             } else {
                 String::new()
-            }
+            },
+            r.bearing
         )
         .map_err(fail)?;
     }
@@ -187,12 +187,12 @@ fn write_logs(
     records: &[DatasetRecord],
     made: &[Vec<f32>],
 ) -> Result<(), CliError> {
-    let bearing = BearingGeometry::parse(&spec.bearing).map_err(CliError::input)?;
     let origin_ns = crate::clock::wall_clock_now_ns();
     records
         .par_iter()
         .zip(made)
         .try_for_each(|(record, samples)| {
+            let bearing = record.geometry().map_err(CliError::input)?;
             let samples: Vec<f64> = samples.iter().map(|&x| f64::from(x)).collect();
             write_raw_log(&RawLog {
                 signal: LogSignal {

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 #[derive(Args)]
 pub struct TrainArgs {
     /// A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to
-    /// train on several (same classes and bearing), e.g. a signal-model and a physics set.
+    /// train on several (same classes, and same bearing on shaft orders), e.g. a signal-model
+    /// and a physics set.
     #[arg(long, required = true)]
     dataset: Vec<PathBuf>,
     /// The model file to write (.safetensors).
@@ -22,6 +23,17 @@ pub struct TrainArgs {
     /// The seed of the initial weights, the corruption noise and the batch order.
     #[arg(long, default_value_t = TrainingSettings::default().seed)]
     seed: u64,
+    /// The input's axis: `shaft` orders (the model knows the data set's one bearing) or
+    /// `fault-relative` orders (each fault's own; the model serves any bearing, best trained
+    /// on data sets of many, e.g. `bearing = "random"`).
+    #[arg(long, value_enum, default_value_t = Axis::Shaft)]
+    axis: Axis,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Axis {
+    Shaft,
+    FaultRelative,
 }
 
 pub fn run(args: &TrainArgs) -> Result<(), CliError> {
@@ -31,8 +43,11 @@ pub fn run(args: &TrainArgs) -> Result<(), CliError> {
         ));
     }
     let started = std::time::Instant::now();
-    let set = TrainingSet::read_all(&args.dataset, FeatureSettings::default())
-        .map_err(CliError::input)?;
+    let features = match args.axis {
+        Axis::Shaft => FeatureSettings::default(),
+        Axis::FaultRelative => FeatureSettings::fault_relative(),
+    };
+    let set = TrainingSet::read_all(&args.dataset, features).map_err(CliError::input)?;
     eprintln!(
         "bearingd: train: {} records → {} segments of {} revolutions ({} classes: {}), inputs made in {:.1} s; every fifth record held out",
         set.records,

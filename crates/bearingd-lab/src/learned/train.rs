@@ -13,7 +13,7 @@ use super::model::{LearnedModel, ModelCard, ModelError, TrainingSummary, CARD_FO
 use super::network::Network;
 use crate::analysis::envelope::FftPlans;
 use crate::random::Rng;
-use crate::twin::dataset::DatasetSpec;
+use crate::twin::dataset::{DatasetSpec, RANDOM_BEARING};
 use crate::twin::SimulatedFault;
 use candle_core::{DType, Device, Tensor, D};
 use candle_nn::{loss, AdamW, Optimizer, ParamsAdamW, VarBuilder, VarMap};
@@ -59,6 +59,8 @@ pub struct TrainingSet {
     pub labels: Vec<u32>,
     /// Whether each segment belongs to a held-out record.
     pub held_out: Vec<bool>,
+    /// The specs' bearings (`random` for sets that draw one per record), each once.
+    pub bearings: Vec<String>,
 }
 
 /// Why a data set cannot be trained on.
@@ -98,14 +100,23 @@ impl TrainingSet {
         let mut all = first?;
         for (dir, set) in dirs.iter().skip(1).zip(sets) {
             let set = set?;
-            if set.spec.faults != all.spec.faults || set.spec.bearing != all.spec.bearing {
+            // On shaft orders a model knows one bearing; on fault-relative orders any.
+            let same_bearing = set.spec.bearing == all.spec.bearing || !features.axis.is_shaft();
+            if set.spec.faults != all.spec.faults || !same_bearing {
                 return Err(TrainingError::DataSet {
                     file: dir.join("spec.toml").display().to_string(),
                     why: format!(
-                        "its classes ({:?}) and bearing ({}) must be those of the first data set ({:?}, {})",
-                        set.spec.faults, set.spec.bearing, all.spec.faults, all.spec.bearing
+                        "its classes ({:?}) and bearing ({}) must be those of the first data set ({:?}, {}){}",
+                        set.spec.faults,
+                        set.spec.bearing,
+                        all.spec.faults,
+                        all.spec.bearing,
+                        if same_bearing { "" } else { " (or train on fault-relative orders: --axis fault-relative)" }
                     ),
                 });
+            }
+            if !all.bearings.contains(&set.spec.bearing) {
+                all.bearings.push(set.spec.bearing.clone());
             }
             all.records += set.records;
             all.inputs.extend(set.inputs);
@@ -163,15 +174,38 @@ impl TrainingSet {
                 spec.faults.len()
             )));
         }
+        if features.axis.is_shaft() && spec.bearing == RANDOM_BEARING {
+            return Err(problem(
+                &spec_path,
+                "its records each have their own bearing (bearing = \"random\"), which a model on shaft orders cannot learn; train on fault-relative orders (--axis fault-relative)".into(),
+            ));
+        }
+        // Each record's bearing is the spec's draw for it: the rows of x are the spec's
+        // records, in order.
+        let records = spec.records();
+        if records.len() != x.nrows() {
+            return Err(npz_problem(format!(
+                "x has {} rows, but the spec makes {} records",
+                x.nrows(),
+                records.len()
+            )));
+        }
+        let geometries = records
+            .iter()
+            .map(|record| record.geometry())
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|why| problem(&spec_path, why))?;
         let fs_hz = spec.fs_hz;
         let per_record: Vec<Vec<f32>> = x
             .outer_iter()
             .collect::<Vec<_>>()
             .par_iter()
             .zip(rpm.to_vec().par_iter())
-            .map(|(row, &rpm)| {
+            .zip(geometries.par_iter())
+            .map(|((row, &rpm), geometry)| {
                 let samples: Vec<f32> = row.iter().copied().collect();
-                features.record_inputs(&mut FftPlans::default(), &samples, fs_hz, rpm / 60.0)
+                let freqs = geometry.fault_frequencies(rpm / 60.0);
+                features.record_inputs(&mut FftPlans::default(), &samples, fs_hz, &freqs)
             })
             .collect();
         let bins = features.order_bins;
@@ -182,6 +216,7 @@ impl TrainingSet {
             inputs: Vec::new(),
             labels: Vec::new(),
             held_out: Vec::new(),
+            bearings: vec![spec.bearing.clone()],
             spec,
         };
         for (index, (inputs, &label)) in per_record.iter().zip(&y).enumerate() {
@@ -322,7 +357,11 @@ pub fn train(
     let card = ModelCard {
         format: CARD_FORMAT,
         classes,
-        bearing: set.spec.bearing.clone(),
+        bearing: if set.features.axis.is_shaft() {
+            set.spec.bearing.clone()
+        } else {
+            format!("any (trained on {})", set.bearings.join(", "))
+        },
         features: set.features,
         training: TrainingSummary {
             dataset_spec: set.spec_text.clone(),

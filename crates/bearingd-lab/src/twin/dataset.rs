@@ -13,6 +13,9 @@ use serde::{Deserialize, Serialize};
 /// The signal model's resonance when the spec gives none (the simulator's example).
 const DEFAULT_RESONANCE_HZ: f64 = 3_000.0;
 
+/// The spec's `bearing` that draws a geometry per record ([`random_bearing`]).
+pub const RANDOM_BEARING: &str = "random";
+
 /// Which model makes the records.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -44,7 +47,8 @@ pub struct DatasetSpec {
     pub model: DatasetModel,
     pub duration_s: f64,
     pub fs_hz: f64,
-    /// A catalog name or a custom geometry (`z=9,d=7.94mm,D=39.04mm,alpha=0`).
+    /// A catalog name, a custom geometry (`z=9,d=7.94mm,D=39.04mm,alpha=0`), or `random`: each
+    /// record draws its own geometry (for a model that serves any bearing).
     pub bearing: String,
     /// Each range is `[low, high]`; a record draws uniformly within it.
     pub rpm: [f64; 2],
@@ -84,6 +88,9 @@ pub struct DatasetRecord {
     pub resonance_hz: f64,
     /// The record's own seed (noise, slip).
     pub seed: u64,
+    /// The record's bearing (the spec's, or its own draw with `bearing = "random"`), as a
+    /// catalog name or a custom geometry.
+    pub bearing: String,
 }
 
 impl DatasetSpec {
@@ -129,8 +136,13 @@ impl DatasetSpec {
                 self.duration_s
             ),
         );
-        if let Err(e) = BearingGeometry::parse(&self.bearing) {
-            check(false, format!("bearing = {:?}: {e}", self.bearing));
+        if self.bearing != RANDOM_BEARING {
+            if let Err(e) = BearingGeometry::parse(&self.bearing) {
+                check(
+                    false,
+                    format!("bearing = {:?}: {e}, or \"{RANDOM_BEARING}\"", self.bearing),
+                );
+            }
         }
         let ranges = [
             ("rpm", self.rpm, f64::MIN_POSITIVE),
@@ -173,6 +185,12 @@ impl DatasetSpec {
                     (DatasetModel::Signal, None) => DEFAULT_RESONANCE_HZ,
                     (DatasetModel::Physics, _) => 0.0,
                 };
+                // Drawn last, so that a set with a fixed bearing draws what it always drew.
+                let bearing = if self.bearing == RANDOM_BEARING {
+                    random_bearing(&mut rng).spec()
+                } else {
+                    self.bearing.clone()
+                };
                 records.push(DatasetRecord {
                     index,
                     fault,
@@ -188,6 +206,7 @@ impl DatasetSpec {
                     load_n,
                     resonance_hz,
                     seed,
+                    bearing,
                 });
             }
         }
@@ -196,7 +215,7 @@ impl DatasetSpec {
 
     /// The samples (g) of `record`.
     pub fn generate(&self, record: &DatasetRecord) -> Result<Vec<f32>, String> {
-        let bearing = BearingGeometry::parse(&self.bearing).map_err(|e| e.to_string())?;
+        let bearing = record.geometry()?;
         match self.model {
             DatasetModel::Signal => {
                 let params = SimulationParams {
@@ -235,6 +254,39 @@ impl DatasetSpec {
                 Ok(samples)
             }
         }
+    }
+}
+
+impl DatasetRecord {
+    /// The record's bearing geometry.
+    pub fn geometry(&self) -> Result<BearingGeometry, String> {
+        BearingGeometry::parse(&self.bearing)
+            .map_err(|e| format!("bearing {:?}: {e}", self.bearing))
+    }
+}
+
+/// A deep-groove or angular-contact ball bearing of plausible proportions: 7 to 18 balls, ball
+/// over pitch diameter 0.11 to 0.30, pitch 25 to 75 mm, and half of them with a contact angle
+/// of 5° to 25°. Its fault orders span those of the catalog's bearings and more (BPFO 2.4–8.1
+/// shaft orders, BPFI 3.8–11.7, BSF 1.5–4.5; the catalog's: 3.0–7.1, 4.8–8.9, 2.0–4.2).
+pub fn random_bearing(rng: &mut Rng) -> BearingGeometry {
+    let balls = 7 + (rng.uniform() * 12.0).floor().min(11.0) as u32;
+    let ratio = 0.11 + 0.19 * rng.uniform();
+    let pitch_mm = 25.0 + 50.0 * rng.uniform();
+    let angular = rng.uniform() < 0.5;
+    let contact_angle_deg = if angular {
+        5.0 + 20.0 * rng.uniform()
+    } else {
+        0.0
+    };
+    // Rounded as a catalog would give them, so that the record's spec reads back the same.
+    let round = |v: f64, places: i32| (v * 10f64.powi(places)).round() / 10f64.powi(places);
+    BearingGeometry {
+        name: "custom".to_string(),
+        rolling_elements: balls,
+        element_diameter_mm: round(ratio * pitch_mm, 3),
+        pitch_diameter_mm: round(pitch_mm, 3),
+        contact_angle_deg: round(contact_angle_deg, 1),
     }
 }
 
@@ -293,5 +345,34 @@ load_n = [500, 2000]
             "{problems:?}"
         );
         assert!(problems.iter().any(|p| p.contains("rpm")), "{problems:?}");
+    }
+
+    #[test]
+    fn a_random_bearing_set_draws_a_geometry_per_record_and_keeps_the_rest_of_its_draws() {
+        let fixed = DatasetSpec::parse(SPEC).unwrap().records();
+        let random = DatasetSpec::parse(&SPEC.replace("\"skf-6205-2rs\"", "\"random\""))
+            .unwrap()
+            .records();
+        assert!(fixed.iter().all(|r| r.bearing == "skf-6205-2rs"));
+        for (f, r) in fixed.iter().zip(&random) {
+            assert_eq!(
+                (f.rpm, f.noise_g, f.severity),
+                (r.rpm, r.noise_g, r.severity)
+            );
+            let geometry = r.geometry().expect("the drawn geometry reads back");
+            assert_eq!(geometry.spec(), r.bearing);
+        }
+        let distinct: std::collections::BTreeSet<_> = random.iter().map(|r| &r.bearing).collect();
+        assert_eq!(distinct.len(), random.len(), "{distinct:?}");
+        let mut rng = Rng::new(11);
+        for _ in 0..2_000 {
+            let b = random_bearing(&mut rng);
+            let f = b.fault_frequencies(1.0);
+            assert!((7..=18).contains(&b.rolling_elements), "{b:?}");
+            assert!((2.3..8.2).contains(&f.bpfo), "{b:?} {f:?}");
+            assert!((3.8..11.8).contains(&f.bpfi), "{b:?} {f:?}");
+            assert!((1.4..4.6).contains(&f.bsf), "{b:?} {f:?}");
+            assert_eq!(BearingGeometry::parse(&b.spec()).as_ref(), Ok(&b));
+        }
     }
 }
