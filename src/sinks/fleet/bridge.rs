@@ -201,7 +201,11 @@ fn mqtt_options(config: &FleetConfig) -> Result<MqttOptions, BridgeError> {
     if config.broker.tls {
         #[cfg(feature = "tls")]
         {
-            let tls = tls_config(config)?;
+            let tls = super::tls::client_config(config).map_err(|p| BridgeError::Tls {
+                key: p.key,
+                path: p.path,
+                problem: p.problem,
+            })?;
             options.set_transport(rumqttc::Transport::tls_with_config(
                 rumqttc::TlsConfiguration::Rustls(Arc::new(tls)),
             ));
@@ -216,82 +220,6 @@ fn mqtt_options(config: &FleetConfig) -> Result<MqttOptions, BridgeError> {
         });
     }
     Ok(options)
-}
-
-/// rustls with the ring provider: the CA file's certificates (or the system's roots), and the
-/// client certificate when configured.
-#[cfg(feature = "tls")]
-fn tls_config(config: &FleetConfig) -> Result<rustls::ClientConfig, BridgeError> {
-    use rustls::pki_types::pem::PemObject;
-    use rustls::pki_types::{CertificateDer, PrivateKeyDer};
-    let tls_error = |key: &'static str, path: &Path, problem: String| BridgeError::Tls {
-        key,
-        path: path.to_path_buf(),
-        problem,
-    };
-    let mut roots = rustls::RootCertStore::empty();
-    match &config.ca_file {
-        Some(path) => {
-            let certificates: Vec<CertificateDer> = CertificateDer::pem_file_iter(path)
-                .and_then(|i| i.collect::<Result<_, _>>())
-                .map_err(|e| tls_error("ca_file", path, format!("not PEM certificates: {e}")))?;
-            if certificates.is_empty() {
-                return Err(tls_error(
-                    "ca_file",
-                    path,
-                    "holds no certificate (expected -----BEGIN CERTIFICATE-----)".into(),
-                ));
-            }
-            for certificate in certificates {
-                roots.add(certificate).map_err(|e| {
-                    tls_error("ca_file", path, format!("a certificate is unusable: {e}"))
-                })?;
-            }
-        }
-        None => {
-            let found = rustls_native_certs::load_native_certs();
-            for certificate in found.certs {
-                let _ = roots.add(certificate);
-            }
-            if roots.is_empty() {
-                return Err(tls_error(
-                    "ca_file",
-                    Path::new("(not set)"),
-                    "no CA file and no system certificates: give the broker's CA as ca_file".into(),
-                ));
-            }
-        }
-    }
-    let provider = Arc::new(rustls::crypto::ring::default_provider());
-    let builder = rustls::ClientConfig::builder_with_provider(provider)
-        .with_safe_default_protocol_versions()
-        .map_err(|e| {
-            tls_error(
-                "broker",
-                Path::new(""),
-                format!("no TLS protocol version: {e}"),
-            )
-        })?
-        .with_root_certificates(roots);
-    match (&config.client_cert_file, &config.client_key_file) {
-        (Some(cert), Some(key)) => {
-            let chain: Vec<CertificateDer<'static>> = CertificateDer::pem_file_iter(cert)
-                .and_then(|i| i.collect::<Result<_, _>>())
-                .map_err(|e| {
-                    tls_error(
-                        "client_cert_file",
-                        cert,
-                        format!("not PEM certificates: {e}"),
-                    )
-                })?;
-            let key_der = PrivateKeyDer::from_pem_file(key)
-                .map_err(|e| tls_error("client_key_file", key, format!("no private key: {e}")))?;
-            builder
-                .with_client_auth_cert(chain, key_der)
-                .map_err(|e| tls_error("client_key_file", key, format!("unusable: {e}")))
-        }
-        _ => Ok(builder.with_no_client_auth()),
-    }
 }
 
 fn read_bd_seq(dir: &Path) -> Option<u64> {

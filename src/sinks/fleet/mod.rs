@@ -13,6 +13,7 @@
 //!   (sans-IO).
 //! - [`queue`]: the bounded on-disk store-and-forward queue.
 //! - [`bridge`]: the I/O around them: the MQTT 5 client (rumqttc, rustls), reconnects, acks.
+//! - `tls`: the bridge's TLS client setup (rustls; with the cargo feature `tls`).
 //! - [`adapter`]: the one place that knows the daemon's message types and its `Sink` trait.
 //! - [`decode`]: payloads back to text, for `bearingd fleet-decode`.
 
@@ -23,5 +24,7 @@ pub mod metrics;
 pub mod node;
 pub mod queue;
 pub mod sparkplug;
+#[cfg(feature = "tls")]
+mod tls;
 
 pub use adapter::FleetSink;
