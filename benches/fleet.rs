@@ -148,6 +148,7 @@ fn fleet_config(broker: &Mosquitto, dir: &std::path::Path) -> FleetConfig {
         keep_alive_s: 30.0,
         queue_dir: dir.join("bench-queue"),
         queue_max_mb: 256.0,
+        primary_host_id: None,
     }
 }
 

@@ -213,4 +213,5 @@ pub(crate) struct RawFleet {
     pub keep_alive_s: Field<f64>,
     pub queue_dir: Field<String>,
     pub queue_max_mb: Field<f64>,
+    pub primary_host_id: Field<String>,
 }

@@ -444,6 +444,11 @@ pub struct FleetConfig {
     pub queue_dir: PathBuf,
     /// The queue's size limit, in MiB; when full, the oldest records are dropped and counted.
     pub queue_max_mb: f64,
+    /// The Sparkplug 3.0 primary host whose STATE (`spBv1.0/STATE/<id>`) gates publishing:
+    /// births and data only while it is online, records queued meanwhile. `None`: publish
+    /// whenever connected.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub primary_host_id: Option<String>,
 }
 
 impl FleetConfig {

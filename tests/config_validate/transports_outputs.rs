@@ -1,7 +1,7 @@
 //! Where samples come from and where results go: transport tables, outputs, the iceoryx2
 //! root, the CPU wake-up latency.
 
-use super::{assert_has_fix, config_of, keys, problems, SENSOR};
+use super::{assert_has_fix, config_of, find, keys, problems, SENSOR};
 use bearingd::config::{self, CanConfig, Transport};
 
 #[test]
@@ -150,4 +150,36 @@ fn an_mqtts_broker_is_used_with_the_tls_feature_and_a_problem_naming_it_without(
     let plain = fleet.replace("mqtts://", "mqtt://");
     let broker = config_of(&plain).fleet.map(|f| f.broker.to_string());
     assert_eq!(broker.as_deref(), Some("mqtt://broker.plant:1883"));
+}
+
+#[test]
+fn a_primary_host_id_with_topic_characters_is_listed_with_the_other_fleet_problems() {
+    let text = format!(
+        "{SENSOR}[fleet]\nenabled = true\nnode_id = \"press 7\"\npublish_period_s = 0\n\
+         primary_host_id = \"plant/scada-#\"\n"
+    );
+    let found = problems(&text);
+    let mut found_keys = keys(&found);
+    found_keys.sort_unstable();
+    assert_eq!(
+        found_keys,
+        [
+            "fleet.node_id",
+            "fleet.primary_host_id",
+            "fleet.publish_period_s"
+        ],
+        "{found:#?}"
+    );
+    let host = find(&found, "fleet.primary_host_id");
+    assert!(host.message.contains("\"plant/scada-#\""), "{host}");
+    assert!(host.message.contains("'/', '#'"), "{host}");
+    found.iter().for_each(assert_has_fix);
+
+    let fine = format!(
+        "{SENSOR}[fleet]\nenabled = true\nnode_id = \"press-7\"\nprimary_host_id = \"scada-1\"\n"
+    );
+    let fleet = config_of(&fine).fleet.expect("the bridge is on");
+    assert_eq!(fleet.primary_host_id.as_deref(), Some("scada-1"));
+    let without = fine.replace("primary_host_id = \"scada-1\"\n", "");
+    assert_eq!(config_of(&without).fleet.unwrap().primary_host_id, None);
 }

@@ -17,9 +17,14 @@ for it, so a broker restart loses nothing on the subscriber's side. MQTT-level d
 (the same topic and bytes again, e.g. a redelivery after the subscriber's own reconnect) are
 counted, not checked twice.
 
+STATE messages of primary hosts (spBv1.0/STATE/<host>, Sparkplug 3.0 JSON, not protobuf) are
+written as lines of type "STATE" with their payload as text, and are not checked.
+
 Usage: sparkplug_subscriber.py --port P --cafile CA --username U --password P --proto FILE
            --out messages.jsonl [--client-id ID] [--rebirth-after N]
-Prints `READY` once subscribed; on end of stdin prints the summary and exits.
+Prints `READY` once subscribed. Each stdin line `state HOST retain|once PAYLOAD` publishes PAYLOAD
+on spBv1.0/STATE/HOST at QoS 1 (retained or not) and prints `PUBLISHED` once the broker has it;
+on end of stdin prints the summary and exits.
 """
 
 import argparse
@@ -280,6 +285,18 @@ def main():
                 state["duplicates"] += 1
                 return
             seen.add(key)
+            if message.topic.startswith("spBv1.0/STATE/"):
+                counts["STATE"] = counts.get("STATE", 0) + 1
+                state_line = {
+                    "topic": message.topic,
+                    "type": "STATE",
+                    "host": message.topic.split("/", 2)[2],
+                    "payload": bytes(message.payload).decode("utf-8", "replace"),
+                    "received_ms": received_ms,
+                }
+                out.write(json.dumps(state_line) + "\n")
+                out.flush()
+                return
             try:
                 msg = decode(payload_cls, message.topic, message.payload, received_ms)
             except Exception as e:  # a payload our .proto cannot read is a finding
@@ -325,7 +342,20 @@ def main():
         print("subscriber: not subscribed within 30 s", file=sys.stderr, flush=True)
         sys.exit(2)
     print("READY", flush=True)
-    sys.stdin.read()
+    for line in sys.stdin:
+        words = line.rstrip("\n").split(" ", 3)
+        if len(words) == 4 and words[0] == "state":
+            _, host, retain, payload = words
+            info = client.publish(
+                f"spBv1.0/STATE/{host}",
+                payload.encode("utf-8"),
+                qos=1,
+                retain=retain == "retain",
+            )
+            info.wait_for_publish(15)
+            print("PUBLISHED" if info.is_published() else "NOT PUBLISHED", flush=True)
+        elif line.strip():
+            print(f"subscriber: unknown command {line!r}", file=sys.stderr, flush=True)
     time.sleep(0.3)  # what is on its way
     client.loop_stop()
     client.disconnect()

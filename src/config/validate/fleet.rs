@@ -47,6 +47,8 @@ const DEFAULT_PERIOD_S: f64 = 1.0;
 const DEFAULT_KEEP_ALIVE_S: f64 = 30.0;
 const DEFAULT_QUEUE_MB: f64 = 64.0;
 const MAX_SPARKPLUG_ID_LEN: usize = 64;
+/// Far below MQTT's 65 535-byte topic limit, far above any host id in use.
+const MAX_HOST_ID_LEN: usize = 256;
 
 impl Checker {
     /// `Some(None)`: the bridge is off; `None`: a problem was reported.
@@ -158,6 +160,7 @@ impl Checker {
             Limits::within(0.01, 1_048_576.0),
             "give the queue's size limit in MiB, e.g. queue_max_mb = 64",
         );
+        let primary_host_id = self.primary_host_id(&raw.primary_host_id);
 
         // Checks across keys, each only when its keys passed on their own.
         let mut consistent = true;
@@ -227,6 +230,7 @@ impl Checker {
             keep_alive_s: keep_alive_s?,
             queue_dir: queue_dir?,
             queue_max_mb: queue_max_mb?,
+            primary_host_id: primary_host_id?,
         }))
         .filter(|_| consistent)
     }
@@ -326,6 +330,47 @@ impl Checker {
         }
     }
 
+    /// The Sparkplug 3.0 primary host id: any text but the MQTT topic separator and wildcards
+    /// (`/`, `+`, `#`, the specification's reserved characters) and control characters, since it
+    /// names the topic `spBv1.0/STATE/<id>`. `Some(None)`: not set.
+    fn primary_host_id(&mut self, field: &Field<String>) -> Option<Option<String>> {
+        let key = "fleet.primary_host_id";
+        let fix = format!(
+            "give the host application id its STATE topic spBv1.0/STATE/<id> carries (1 to \
+             {MAX_HOST_ID_LEN} bytes, without '/', '+', '#' or control characters), e.g. \
+             primary_host_id = \"scada-1\", or leave it out to publish whenever connected"
+        );
+        let value = self.optional_text(key, field, &fix)?;
+        let Some(id) = value else {
+            return Some(None);
+        };
+        let mut wrong: Vec<String> = ['/', '+', '#']
+            .into_iter()
+            .filter(|c| id.contains(*c))
+            .map(|c| format!("'{c}'"))
+            .collect();
+        if id.chars().any(char::is_control) {
+            wrong.push("a control character".into());
+        }
+        if id.trim() != id {
+            wrong.push("leading or trailing blanks".into());
+        }
+        if id.len() > MAX_HOST_ID_LEN {
+            wrong.push(format!("{} bytes", id.len()));
+        }
+        if wrong.is_empty() {
+            return Some(Some(id));
+        }
+        self.problem(
+            key,
+            format!(
+                "{id:?} cannot name an MQTT topic: it has {}; {fix}",
+                wrong.join(", ")
+            ),
+        );
+        None
+    }
+
     fn text(&mut self, key: &str, field: &Field<String>, fix: &str) -> Option<String> {
         self.optional_text(key, field, fix).flatten()
     }
@@ -385,6 +430,82 @@ mod tests {
         let plain = check.broker("mqtt://broker.plant", false);
         assert_eq!(plain.map(|b| (b.tls, b.port)), Some((false, 1883)));
         assert!(check.problems.is_empty());
+    }
+
+    #[test]
+    fn a_primary_host_id_is_optional_and_may_not_hold_topic_characters() {
+        let id = |text: &str| Some(Loose::Value(text.to_string()));
+        let mut check = Checker::default();
+        assert_eq!(check.primary_host_id(&None), Some(None));
+        assert_eq!(
+            check.primary_host_id(&id("scada-1")),
+            Some(Some("scada-1".into()))
+        );
+        assert_eq!(
+            check.primary_host_id(&id("Ignition Gateway (hall 3)")),
+            Some(Some("Ignition Gateway (hall 3)".into()))
+        );
+        assert!(check.problems.is_empty(), "{:?}", check.problems);
+        for (bad, said) in [
+            ("", "is empty"),
+            ("   ", "is empty"),
+            ("plant/scada", "'/'"),
+            ("scada+", "'+'"),
+            ("#", "'#'"),
+            ("a/b+c#", "'/', '+', '#'"),
+            ("scada\u{1}", "a control character"),
+            (" scada", "leading or trailing blanks"),
+        ] {
+            let mut check = Checker::default();
+            assert_eq!(check.primary_host_id(&id(bad)), None, "{bad:?}");
+            assert_eq!(check.problems.len(), 1, "{bad:?}");
+            let problem = check.problems[0].to_string();
+            assert!(problem.contains("fleet.primary_host_id"), "{problem}");
+            assert!(problem.contains(said), "{bad:?}: {problem}");
+            assert!(problem.contains("e.g. primary_host_id = "), "{problem}");
+        }
+        let mut check = Checker::default();
+        assert_eq!(check.primary_host_id(&id(&"h".repeat(300))), None);
+        assert!(check.problems[0].to_string().contains("300 bytes"));
+        let mut check = Checker::default();
+        let wrong_type = Some(Loose::WrongType {
+            found: "an integer".into(),
+        });
+        assert_eq!(check.primary_host_id(&wrong_type), None);
+        assert_eq!(check.problems.len(), 1);
+    }
+
+    #[test]
+    fn a_bad_primary_host_id_is_listed_with_the_other_problems_even_when_disabled() {
+        for enabled in [true, false] {
+            let raw = RawFleet {
+                enabled: Some(Loose::Value(enabled)),
+                node_id: Some(Loose::Value("press/7".into())),
+                primary_host_id: Some(Loose::Value("scada/#".into())),
+                publish_period_s: Some(Loose::Value(-1.0)),
+                ..RawFleet::default()
+            };
+            let mut check = Checker::default();
+            let _ = check.fleet(&raw, Some(Path::new("/tmp")));
+            let keys: Vec<String> = check.problems.iter().map(|p| p.to_string()).collect();
+            assert_eq!(keys.len(), 3, "{keys:?}");
+            assert!(
+                keys.iter().any(|p| p.contains("fleet.primary_host_id")),
+                "{keys:?}"
+            );
+        }
+        let raw = RawFleet {
+            enabled: Some(Loose::Value(true)),
+            node_id: Some(Loose::Value("press-7".into())),
+            primary_host_id: Some(Loose::Value("scada-1".into())),
+            ..RawFleet::default()
+        };
+        let mut check = Checker::default();
+        let config = check
+            .fleet(&raw, Some(Path::new("/tmp")))
+            .flatten()
+            .unwrap();
+        assert_eq!(config.primary_host_id.as_deref(), Some("scada-1"));
     }
 
     #[test]

@@ -21,14 +21,18 @@
 //! 4. a lost connection ends the session: what was not acknowledged is sent again in the next
 //!    one (with the next `bdSeq`, a fresh NBIRTH/DBIRTH and new `seq` numbers), after a pause
 //!    that doubles from 1 s up to 30 s. rumqttc's own replay of unacknowledged packets is not
-//!    used (a new client per session): its packets would carry the old session's `seq`.
+//!    used (a new client per session): its packets would carry the old session's `seq`;
+//! 5. with a primary host (`fleet.primary_host_id`), the births and step 3 wait until its STATE
+//!    says online, and stop while it says offline; the records wait in the queue meanwhile
+//!    (`host_state.rs`, [`super::primary`]).
 
 use super::metrics::{MetricBook, Observation};
 use super::node::{decode_record, encode_record, Command, EdgeNode, Publish, Qos};
+use super::primary::{HostStats, PrimaryHost};
 use super::queue::{DiskQueue, QueueError, QueueStats};
 use super::sparkplug::Value;
 use crate::config::FleetConfig;
-use rumqttc::v5::mqttbytes::v5::{ConnectReturnCode, LastWill, Packet, PubAckReason};
+use rumqttc::v5::mqttbytes::v5::{LastWill, Packet, PubAckReason};
 use rumqttc::v5::mqttbytes::QoS;
 use rumqttc::v5::{AsyncClient, ConnectionError, Event, MqttOptions};
 use rumqttc::Outgoing;
@@ -38,6 +42,10 @@ use std::sync::Arc;
 use std::time::Duration;
 use tokio::sync::mpsc;
 use tokio::time::Instant;
+
+mod host_state;
+mod refusals;
+use refusals::{puback_code, refusal};
 
 /// Where the bridge's notices go (a connection, a refusal, a full queue, the summary at the
 /// stop), one line each without the `bearingd: ` prefix; called from the bridge thread. The
@@ -96,6 +104,9 @@ pub struct BridgeSummary {
     /// Records of devices no longer configured, found in the queue and skipped.
     pub stale_records: u64,
     pub bd_seq: u64,
+    /// What the primary host's STATE messages did (`fleet.primary_host_id` set).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub primary_host: Option<HostStats>,
 }
 
 /// The running bridge: the sending end of its intake and its thread.
@@ -140,7 +151,9 @@ pub fn start(
         Value::String(env!("CARGO_PKG_VERSION").into()),
     )]);
     let (intake, intake_rx) = mpsc::channel(INTAKE);
+    let primary = config.primary_host_id.as_deref().map(PrimaryHost::new);
     let bridge = Bridge {
+        primary,
         config,
         options,
         book,
@@ -264,6 +277,10 @@ struct Session {
     in_flight: BTreeSet<u64>,
     /// The broker refused something: close the session.
     refused: bool,
+    /// Per subscription handed to the client, in order: whether it is the primary host's STATE.
+    subscribes: VecDeque<bool>,
+    /// The packet id of the STATE subscription, for its SUBACK.
+    state_subscription: Option<u16>,
 }
 
 struct Bridge {
@@ -273,6 +290,8 @@ struct Bridge {
     node: EdgeNode,
     queue: DiskQueue,
     session: Option<Session>,
+    /// `fleet.primary_host_id`: births and data only while its STATE says online.
+    primary: Option<PrimaryHost>,
     summary: BridgeSummary,
     /// The last problem reported, so that a retry loop says it once.
     last_report: String,
@@ -359,9 +378,12 @@ impl Bridge {
     /// session still connecting is waited for (within the stop's grace), so that a short run
     /// delivers what it made.
     fn drained(&self) -> bool {
+        // With the primary host offline nothing more would be sent within the grace.
+        let open = self.may_publish();
         match &self.session {
             Some(s) if s.up => {
-                s.refused || (s.in_flight.is_empty() && s.cursor >= self.queue.next_number())
+                s.refused
+                    || (s.in_flight.is_empty() && (!open || s.cursor >= self.queue.next_number()))
             }
             Some(_) => false,
             None => true,
@@ -418,6 +440,8 @@ impl Bridge {
             by_packet: HashMap::new(),
             in_flight: BTreeSet::new(),
             refused: false,
+            subscribes: VecDeque::new(),
+            state_subscription: None,
         });
     }
 
@@ -499,11 +523,36 @@ impl Bridge {
             }
             Event::Incoming(Packet::Publish(publish))
                 if publish.topic.as_ref() == self.node.command_topic().as_bytes()
-                    && self.node.command(&publish.payload) == Some(Command::Rebirth) =>
+                    && self.node.command(&publish.payload) == Some(Command::Rebirth)
+                    // With the primary host offline the births wait for it to be online.
+                    && self.may_publish() =>
             {
                 (self.notices)("fleet: rebirth requested (NCMD): births sent again".into());
                 let births = self.node.births(&self.book, now_ms());
                 self.send(births);
+            }
+            Event::Incoming(Packet::Publish(publish))
+                if self
+                    .primary
+                    .as_ref()
+                    .is_some_and(|p| publish.topic.as_ref() == p.topic().as_bytes()) =>
+            {
+                self.on_state(&publish.payload);
+            }
+            Event::Outgoing(Outgoing::Subscribe(packet)) => {
+                if let Some(session) = self.session.as_mut() {
+                    if session.subscribes.pop_front() == Some(true) {
+                        session.state_subscription = Some(packet);
+                    }
+                }
+            }
+            Event::Incoming(Packet::SubAck(ack))
+                if self
+                    .session
+                    .as_ref()
+                    .is_some_and(|s| s.state_subscription == Some(ack.pkid)) =>
+            {
+                self.on_state_suback(&ack.return_codes);
             }
             Event::Incoming(Packet::Disconnect(d)) => {
                 self.report(format!(
@@ -531,6 +580,21 @@ impl Bridge {
         session.cursor = self.queue.first_pending();
         let topic = self.node.command_topic();
         let _ = session.client.try_subscribe(topic, QoS::AtLeastOnce);
+        session.subscribes.push_back(false);
+        // The primary host's STATE before any birth: offline until it says otherwise.
+        let mut waiting = String::new();
+        if let Some(primary) = self.primary.as_mut() {
+            primary.new_session();
+            let _ = session
+                .client
+                .try_subscribe(primary.topic(), QoS::AtLeastOnce);
+            session.subscribes.push_back(true);
+            waiting = format!(
+                "; waiting for primary host {} to be online ({}) before the births",
+                primary.id(),
+                primary.topic()
+            );
+        }
         self.summary.sessions += 1;
         self.summary.bd_seq = self.node.bd_seq();
         if let Err(e) = write_bd_seq(&self.config.queue_dir, self.node.bd_seq()) {
@@ -539,14 +603,17 @@ impl Bridge {
         let backlog = self.queue.pending();
         self.last_report = String::new();
         (self.notices)(format!(
-            "fleet: connected to {} as {}/{} (bdSeq {}); {backlog} queued records to send",
+            "fleet: connected to {} as {}/{} (bdSeq {}); {backlog} queued records to \
+             send{waiting}",
             self.config.broker,
             self.config.group_id,
             self.config.node_id,
             self.node.bd_seq()
         ));
-        let births = self.node.births(&self.book, now_ms());
-        self.send(births);
+        if self.may_publish() {
+            let births = self.node.births(&self.book, now_ms());
+            self.send(births);
+        }
     }
 
     /// Hands publishes to the client in order; `false` if the client's queue is full.
@@ -580,10 +647,11 @@ impl Bridge {
     /// Publishes queued records in order while the window has room.
     fn pump(&mut self) {
         loop {
+            let open = self.may_publish();
             let Some(session) = self.session.as_mut() else {
                 return;
             };
-            if !session.up || session.refused || session.in_flight.len() >= WINDOW {
+            if !open || !session.up || session.refused || session.in_flight.len() >= WINDOW {
                 return;
             }
             let number = session.cursor.max(self.queue.first_pending());
@@ -654,6 +722,20 @@ impl Bridge {
             (self.notices)(format!("fleet: queue: {e}"));
         }
         self.summary.queue = self.queue.stats();
+        if let Some(primary) = &self.primary {
+            let h = primary.stats();
+            (self.notices)(format!(
+                "fleet: primary host {}: online {} times, offline {} times; {} STATE messages \
+                 ignored ({} unreadable, {} older than the newest)",
+                h.host_id,
+                h.came_online,
+                h.went_offline,
+                h.unreadable + h.stale,
+                h.unreadable,
+                h.stale
+            ));
+            self.summary.primary_host = Some(h.clone());
+        }
         let s = &self.summary;
         (self.notices)(format!(
             "fleet: {} records made, {} acknowledged by the broker, {} left in the \
@@ -677,47 +759,4 @@ fn jitter(pause: Duration) -> Duration {
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.subsec_nanos());
     pause.mul_f64(0.5 + 0.5 * f64::from(nanos % 1000) / 1000.0)
-}
-
-/// A CONNACK refusal in words, with what to check.
-fn refusal(code: ConnectReturnCode, config: &FleetConfig) -> String {
-    let user = config.username.as_deref().unwrap_or("(none)");
-    match code {
-        ConnectReturnCode::BadUserNamePassword => format!(
-            "REFUSED the connection: {code:?} (the user name or password is wrong); check \
-             fleet.username ({user}) and fleet.password_file against the broker's password file"
-        ),
-        // mosquitto answers a wrong password with this code under MQTT 5.
-        ConnectReturnCode::NotAuthorized => format!(
-            "REFUSED the connection: {code:?} (the user name or password is wrong, or the user \
-             may not connect or not publish this node's death certificate \
-             spBv1.0/{}/NDEATH/{}); check fleet.username ({user}) and fleet.password_file \
-             against the broker's password file, and fleet.node_id against its ACL",
-            config.group_id, config.node_id
-        ),
-        ConnectReturnCode::ClientIdentifierNotValid | ConnectReturnCode::BadClientId => format!(
-            "REFUSED the connection: {code:?}; check fleet.client_id ({})",
-            config.client_id
-        ),
-        ConnectReturnCode::Banned => {
-            format!("REFUSED the connection: {code:?}; ask the broker's administrator")
-        }
-        code => format!("REFUSED the connection: {code:?}"),
-    }
-}
-
-/// The MQTT 5 reason code number of a PUBACK reason.
-fn puback_code(reason: PubAckReason) -> String {
-    let code: u8 = match reason {
-        PubAckReason::Success => 0x00,
-        PubAckReason::NoMatchingSubscribers => 0x10,
-        PubAckReason::UnspecifiedError => 0x80,
-        PubAckReason::ImplementationSpecificError => 0x83,
-        PubAckReason::NotAuthorized => 0x87,
-        PubAckReason::TopicNameInvalid => 0x90,
-        PubAckReason::PacketIdentifierInUse => 0x91,
-        PubAckReason::QuotaExceeded => 0x97,
-        PubAckReason::PayloadFormatInvalid => 0x99,
-    };
-    format!("0x{code:02x}")
 }

@@ -11,6 +11,7 @@
 //!   (sans-IO, on the observations' own clock).
 //! - [`node`]: the edge node's session: topics, births and deaths, `bdSeq`, `seq`, rebirth
 //!   (sans-IO).
+//! - [`primary`]: the Sparkplug 3.0 primary host's STATE and whether to publish now (sans-IO).
 //! - [`queue`]: the bounded on-disk store-and-forward queue.
 //! - [`bridge`]: the I/O around them: the MQTT 5 client (rumqttc, rustls), reconnects, acks.
 //! - `tls`: the bridge's TLS client setup (rustls; with the cargo feature `tls`).
@@ -22,6 +23,7 @@ pub mod bridge;
 pub mod decode;
 pub mod metrics;
 pub mod node;
+pub mod primary;
 pub mod queue;
 pub mod sparkplug;
 #[cfg(feature = "tls")]

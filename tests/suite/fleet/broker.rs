@@ -18,7 +18,8 @@ use std::time::{Duration, Instant};
 
 /// The Sparkplug group of every test.
 pub const GROUP: &str = "plant";
-/// The test host (subscriber) user, allowed to read everything and to send commands.
+/// The test host (subscriber) user, allowed to read everything, to send commands and to publish
+/// a primary host's STATE.
 pub const HOST_USER: &str = "scada";
 pub const HOST_PASSWORD: &str = "host-secret";
 /// The load generator of `benches/fleet.rs`: many simulated nodes under group `load`.
@@ -216,6 +217,7 @@ impl Mosquitto {
                  topic read spBv1.0/#\n\
                  topic write spBv1.0/+/NCMD/#\n\
                  topic write spBv1.0/+/DCMD/#\n\
+                 topic write spBv1.0/STATE/#\n\
                  # the load generator's simulated nodes\n\
                  user {LOAD_USER}\n\
                  topic readwrite spBv1.0/load/#\n\
@@ -223,7 +225,9 @@ impl Mosquitto {
                  pattern write spBv1.0/+/+/%u\n\
                  pattern write spBv1.0/+/+/%u/#\n\
                  pattern read spBv1.0/+/NCMD/%u\n\
-                 pattern read spBv1.0/+/DCMD/%u/#\n"
+                 pattern read spBv1.0/+/DCMD/%u/#\n\
+                 # and every primary host's STATE (Sparkplug 3.0)\n\
+                 pattern read spBv1.0/STATE/+\n"
             ),
         )
         .unwrap();

@@ -1,6 +1,7 @@
 //! The Python Sparkplug B host (`tests/python/sparkplug_subscriber.py`) as a child process: it
-//! writes every decoded message as a JSON line (read here to wait for events) and, at the end
-//! of its stdin, checks the Sparkplug rules and prints a summary.
+//! writes every decoded message as a JSON line (read here to wait for events), publishes a
+//! primary host's STATE when told on its stdin, and at the end of its stdin checks the Sparkplug
+//! rules and prints a summary.
 
 use super::broker::{Mosquitto, HOST_PASSWORD, HOST_USER};
 use serde_json::Value;
@@ -100,6 +101,20 @@ impl Host {
                 );
             }
             std::thread::sleep(Duration::from_millis(200));
+        }
+    }
+
+    /// Publishes `payload` as the STATE of primary host `host_id` (`spBv1.0/STATE/<id>`, QoS 1,
+    /// retained if `retain`) and waits for the broker's acknowledgement.
+    pub fn publish_state(&mut self, host_id: &str, retain: bool, payload: &str) {
+        use std::io::Write;
+        let retain = if retain { "retain" } else { "once" };
+        let stdin = self.child.stdin.as_mut().expect("the host's stdin");
+        writeln!(stdin, "state {host_id} {retain} {payload}").expect("write to the host");
+        stdin.flush().expect("write to the host");
+        match self.lines.recv_timeout(Duration::from_secs(20)) {
+            Ok(line) if line == "PUBLISHED" => {}
+            other => panic!("the host did not publish the STATE {payload:?}: {other:?}"),
         }
     }
 

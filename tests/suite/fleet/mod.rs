@@ -422,6 +422,151 @@ fn a_full_queue_drops_the_oldest_counts_them_and_sends_the_rest_in_order() {
     );
 }
 
+/// Each message's topic and seq, for a failure's message.
+fn topics(messages: &[Value]) -> Vec<String> {
+    messages
+        .iter()
+        .map(|m| format!("{} seq {}", m["topic"], m["seq"]))
+        .collect()
+}
+
+/// The Sparkplug 3.0 STATE payload of a primary host.
+fn state(online: bool, timestamp: u64) -> String {
+    format!("{{\"online\": {online}, \"timestamp\": {timestamp}}}")
+}
+
+#[test]
+fn with_a_primary_host_nothing_is_published_while_it_is_offline_and_nothing_is_lost() {
+    const PRIMARY: &str = "scada-1";
+    let Some(setup) = NodeSetup::prepare("fleet-primary") else {
+        return;
+    };
+    let broker = Mosquitto::start(&setup.dir);
+    let mut host = Host::start(&broker, &setup.dir, 0);
+    let from_node = |m: &[Value]| -> Vec<Value> {
+        m.iter()
+            .filter(|x| x["node"] == "press-7")
+            .cloned()
+            .collect()
+    };
+    let t0 = host::now_ms();
+    // The host is offline (its retained STATE) when the node connects.
+    host.publish_state(PRIMARY, true, &state(false, t0));
+    let config = setup.config(&broker, &NODES[0], |c| {
+        c.primary_host_id = Some(PRIMARY.into());
+    });
+    let node = NodeProcess::start(&setup, &config, &[]);
+    node.wait_for_stderr("the connection, waiting for the primary host", 60, |t| {
+        t.contains("waiting for primary host scada-1 to be online (spBv1.0/STATE/scada-1)")
+    });
+    // Connected and making records (one per 1.28 s): nothing published, all queued.
+    std::thread::sleep(Duration::from_secs(4));
+    let early = from_node(&host.messages());
+    assert!(
+        early.is_empty(),
+        "published while the host is offline: {:?}",
+        topics(&early)
+    );
+
+    // Online: NBIRTH, DBIRTH, then the queued records in order, then live data.
+    let online_ms = host::now_ms();
+    host.publish_state(PRIMARY, true, &state(true, t0 + 1));
+    let messages = host.wait_for("births and 6 DDATA after the host came online", 60, |m| {
+        of_type(&from_node(m), "DDATA").len() >= 6
+    });
+    let messages = from_node(&messages);
+    let kinds: Vec<&str> = messages.iter().filter_map(|m| m["type"].as_str()).collect();
+    assert_eq!(kinds[..3], ["NBIRTH", "DBIRTH", "DDATA"], "{kinds:?}");
+    let first = &messages[2];
+    assert_eq!(
+        metric(first, "bearingd/Record"),
+        Some(&Value::from(0)),
+        "{first}"
+    );
+    assert!(
+        first["timestamp"].as_u64() < Some(online_ms),
+        "the first record is from the offline time: {first}"
+    );
+    let said = node.wait_for_stderr("the births notice", 10, |t| {
+        t.contains("primary host scada-1 is online: births sent, then")
+    });
+    let queued = said
+        .split("births sent, then ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse::<u64>().ok())
+        .unwrap_or(0);
+    assert!(queued >= 1, "records were queued while offline: {said}");
+
+    // Offline again: publishing stops at once, the session stays up.
+    host.publish_state(PRIMARY, true, &state(false, t0 + 2));
+    node.wait_for_stderr("the pause", 30, |t| {
+        t.contains("primary host scada-1 is offline")
+    });
+    std::thread::sleep(Duration::from_millis(500)); // what was on its way
+    let paused = from_node(&host.messages()).len();
+    // An online STATE older than the offline one, and a payload that is no STATE: both said,
+    // counted, ignored.
+    host.publish_state(PRIMARY, false, &state(true, t0 + 1));
+    host.publish_state(PRIMARY, false, "bogus");
+    node.wait_for_stderr("the two ignored STATEs", 30, |t| {
+        t.contains("older than the newest seen") && t.contains("\"bogus\": neither")
+    });
+    std::thread::sleep(Duration::from_secs(3));
+    let later = from_node(&host.messages());
+    assert_eq!(
+        later.len(),
+        paused,
+        "published while the host is offline: {:?}",
+        topics(&later[paused..])
+    );
+
+    // Online again: a rebirth (same bdSeq, seq from 0), then what waited, then live data.
+    host.publish_state(PRIMARY, true, &state(true, t0 + 3));
+    host.wait_for("the rebirth and 3 DDATA after it", 60, |m| {
+        let m = from_node(m);
+        of_type(&m, "NBIRTH").len() >= 2
+            && m.iter()
+                .rev()
+                .take_while(|x| x["type"] != "NBIRTH")
+                .filter(|x| x["type"] == "DDATA")
+                .count()
+                >= 3
+    });
+    let stopped = node.terminate();
+    assert!(stopped.success, "{}", stopped.stderr);
+    assert!(
+        stopped.stderr.contains(
+            "primary host scada-1: online 2 times, offline 1 times; 2 STATE messages ignored \
+             (1 unreadable, 1 older than the newest)"
+        ),
+        "{}",
+        stopped.stderr
+    );
+    let summary = host.finish();
+    assert_no_violations(&summary);
+    let births = births_of(&summary, "press-7");
+    assert_eq!(births.len(), 2, "{}", summary["births"]);
+    assert_eq!(
+        births[1], births[0],
+        "one MQTT session: the rebirth keeps the bdSeq"
+    );
+    let records = &summary["records"];
+    assert_eq!(records["first"], 0, "{records}");
+    assert_eq!(
+        records["missing"],
+        serde_json::json!([]),
+        "records lost: {records}"
+    );
+    assert_eq!(records["out_of_order"], serde_json::json!([]), "{records}");
+    assert_eq!(records["resent"], serde_json::json!([]), "{records}");
+    // What waited for the host is marked historical, both times.
+    assert!(
+        records["historical"].as_u64() >= Some(queued + 1),
+        "{records}"
+    );
+}
+
 /// The number before `what` in the bridge's summary line.
 fn summary_count(stderr: &str, what: &str) -> u64 {
     let line = stderr

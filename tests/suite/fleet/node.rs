@@ -26,6 +26,8 @@ pub struct NodeConfig {
     pub ca_file: PathBuf,
     pub client_cert: Option<(PathBuf, PathBuf)>,
     pub queue_max_mb: f64,
+    /// `fleet.primary_host_id`: publish only while this host's STATE says online.
+    pub primary_host_id: Option<String>,
 }
 
 impl NodeSetup {
@@ -58,6 +60,7 @@ impl NodeSetup {
             ca_file: broker.ca(),
             client_cert: None,
             queue_max_mb: 64.0,
+            primary_host_id: None,
         };
         change(&mut c);
         let dir = self.dir.join(&c.name);
@@ -91,6 +94,9 @@ impl NodeSetup {
                 "username = \"{user}\"\npassword_file = \"{}\"\n",
                 password_file.display()
             ));
+        }
+        if let Some(id) = &c.primary_host_id {
+            fleet.push_str(&format!("primary_host_id = \"{id}\"\n"));
         }
         if let Some((cert, key)) = &c.client_cert {
             fleet.push_str(&format!(
