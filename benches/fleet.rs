@@ -11,11 +11,12 @@
 
 #[path = "../tests/suite/fleet/broker.rs"]
 mod broker;
+#[path = "../tests/suite/fleet/sizes.rs"]
+mod sizes;
 
 use bearingd::config::{Broker, FleetConfig};
-use bearingd::messages::{FaultKind, FlagLevel};
 use bearingd::sinks::fleet::bridge;
-use bearingd::sinks::fleet::metrics::{MetricBook, Observation, Observed};
+use bearingd::sinks::fleet::metrics::MetricBook;
 use bearingd::sinks::fleet::node::EdgeNode;
 use bearingd::sinks::fleet::sparkplug::Payload;
 use broker::{Mosquitto, LOAD_PASSWORD, LOAD_USER};
@@ -32,92 +33,28 @@ fn now_ms() -> u64 {
         .map_or(0, |d| d.as_millis() as u64)
 }
 
-fn window(device: usize, at_ms: u64, k: f64) -> Observation {
-    Observation {
-        device,
-        at_ms,
-        what: Observed::Window {
-            rpm: Some(1772.0),
-            rms_g: 0.5 + 0.01 * k,
-            peak_g: 2.0 + 0.01 * k,
-            crest: 4.0 + 0.001 * k,
-            kurtosis: 3.1 + 0.001 * k,
-            scores: [12.0 + k, 1.5, 1.2 + 0.1 * k, 0.9],
-        },
-    }
-}
-
-/// A typical DDATA of one channel: the metrics of one analysis window changed.
-fn typical_ddata(book: &mut MetricBook, node: &mut EdgeNode, at_ms: u64) -> Vec<u8> {
-    // The values change with every period (a value that comes back unchanged is no news and
-    // makes no record: `at_ms % 97` repeated when two stamps were a multiple of 97 ms apart).
-    let k = ((at_ms / 1000) % 97) as f64;
-    let record = book
-        .observe(window(0, at_ms, k))
-        .expect("a record per period");
-    let publishes = node
-        .data(book, &record, at_ms / 1000, false, at_ms)
-        .expect("a known device");
-    publishes.last().expect("the DDATA").payload.clone()
-}
-
 fn sizes() {
-    let mut book = MetricBook::new(vec!["motor-de.radial".into()], 1000);
-    let mut node = EdgeNode::new("plant", "press-7", 1, 0);
     let t0 = now_ms();
-    let births = node.births(&book, t0);
-    let first = typical_ddata(&mut book, &mut node, t0);
-    let typical = typical_ddata(&mut book, &mut node, t0 + 1000);
-    let flag = book
-        .observe(Observation {
-            device: 0,
-            at_ms: t0 + 1500,
-            what: Observed::Flag {
-                fault: FaultKind::OuterRace,
-                level: FlagLevel::Alarm,
-                score: 25.0,
-                confidence: 0.93,
-            },
-        })
-        .expect("a flag goes at once");
-    let flag = node.data(&book, &flag, 3, false, t0 + 1500).unwrap();
-    let twin = book
-        .observe(Observation {
-            device: 0,
-            at_ms: t0 + 2500,
-            what: Observed::Twin {
-                hypothesis: FaultKind::OuterRace,
-                error: 0.03,
-                margin: 0.4,
-                errors: [0.03, 0.4, 0.5],
-                residual_energy_ratio: 0.1,
-                residual_peak_hz: 3100.0,
-            },
-        })
-        .expect("a record");
-    let twin = node.data(&book, &twin, 4, false, t0 + 2500).unwrap();
-    let death = node.death(t0);
+    let s = sizes::measure(t0);
     println!("## message sizes (payload bytes, protobuf)");
-    println!("NBIRTH                      {}", births[0].payload.len());
-    println!("DBIRTH (one channel)        {}", births[1].payload.len());
-    println!("DDATA first (all metrics)   {}", first.len());
-    println!("DDATA typical (one window)  {}", typical.len());
-    println!("DDATA flag change           {}", flag[0].payload.len());
-    println!("DDATA twin fit              {}", twin[0].payload.len());
-    println!("NDEATH                      {}", death.payload.len());
     println!(
-        "topic (DDATA)               {}",
-        node.topic(
-            bearingd::sinks::fleet::node::Kind::DData,
-            Some("motor-de.radial")
-        )
-        .len()
+        "NBIRTH                      {} ({} without the version)",
+        s.nbirth, s.nbirth_bare
     );
+    println!("DBIRTH (one channel)        {}", s.dbirth);
+    println!("DDATA first (all metrics)   {}", s.ddata_first);
+    println!("DDATA typical (one window)  {}", s.ddata_typical);
+    println!("DDATA flag change           {}", s.ddata_flag);
+    println!("DDATA twin fit              {}", s.ddata_twin);
+    println!("NDEATH                      {}", s.ndeath);
+    println!("topic (DDATA)               {}", s.topic);
+    let (mut book, mut node) = sizes::book_and_node();
+    node.births(&book, t0);
     let started = Instant::now();
     let n = 20_000u64;
     let mut bytes = 0;
     for i in 0..n {
-        bytes += typical_ddata(&mut book, &mut node, t0 + 10_000 + i * 1000).len();
+        bytes += sizes::typical_ddata(&mut book, &mut node, t0 + 10_000 + i * 1000).len();
     }
     let per = started.elapsed().as_secs_f64() / n as f64;
     println!(
@@ -168,7 +105,7 @@ fn bridge_throughput(broker: &Mosquitto, dir: &std::path::Path) {
         let at = t0 + (i / devices.len() as u64) * 1000;
         if handle
             .intake
-            .blocking_send(window(device, at, (i % 13) as f64))
+            .blocking_send(sizes::window(device, at, (i % 13) as f64))
             .is_err()
         {
             break;
@@ -326,7 +263,7 @@ async fn load(broker: &Mosquitto, nodes: usize, seconds: u64) {
                         // Stamped now (the subscriber's latency), at least a period after the
                         // last (the book makes one record per period).
                         last = now_ms().max(last + 1000);
-                        let payload = typical_ddata(&mut book, &mut node, last);
+                        let payload = sizes::typical_ddata(&mut book, &mut node, last);
                         if client
                             .publish(topic.clone(), QoS::AtLeastOnce, false, payload)
                             .await

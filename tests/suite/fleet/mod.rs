@@ -9,11 +9,13 @@
 mod broker;
 mod host;
 mod node;
+mod sizes;
 
 use broker::{Mosquitto, GROUP, NODES};
 use host::Host;
 use node::{NodeProcess, NodeSetup};
 use serde_json::Value;
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 fn metric<'a>(message: &'a Value, name: &str) -> Option<&'a Value> {
@@ -582,4 +584,68 @@ fn summary_count(stderr: &str, what: &str) -> u64 {
         .next()
         .and_then(|n| n.parse().ok())
         .unwrap_or_else(|| panic!("no number before {what:?} in {line}"))
+}
+
+/// docs/FLEET.md's table of message sizes against the messages the edge node makes now (no
+/// broker needed): a metric added to the catalog changes the DBIRTH, and the table must say so.
+#[test]
+fn the_documented_message_sizes_are_the_measured_ones() {
+    // A fixed stamp of today's length (6-byte varints until 2039), so that the sizes are fixed.
+    let s = sizes::measure(1_795_000_000_000);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/FLEET.md");
+    let doc = std::fs::read_to_string(&path).unwrap();
+    let section: Vec<&str> = doc
+        .lines()
+        .skip_while(|l| !l.starts_with("**Message sizes**"))
+        .take_while(|l| !l.starts_with("Making and encoding"))
+        .collect();
+    assert!(
+        !section.is_empty(),
+        "no **Message sizes** in {}",
+        path.display()
+    );
+    let numbers = |text: &str| -> Vec<usize> {
+        text.split(|c: char| !c.is_ascii_digit())
+            .filter_map(|n| n.parse().ok())
+            .collect()
+    };
+    let expected = [
+        ("NBIRTH", vec![s.nbirth, s.nbirth_bare]),
+        ("DBIRTH", vec![s.dbirth]),
+        ("DDATA, first", vec![s.ddata_first]),
+        ("DDATA, typical", vec![s.ddata_typical]),
+        ("DDATA, flag change", vec![s.ddata_flag]),
+        ("DDATA, twin fit", vec![s.ddata_twin]),
+        ("NDEATH", vec![s.ndeath]),
+    ];
+    let mut wrong = Vec::new();
+    for (label, measured) in &expected {
+        let row = section
+            .iter()
+            .find(|l| l.starts_with(&format!("| {label}")))
+            .unwrap_or_else(|| panic!("no row {label:?} in the table of {}", path.display()));
+        let said = numbers(row.rsplit('|').nth(1).unwrap_or(""));
+        if &said != measured {
+            wrong.push(format!(
+                "{label}: the table says {said:?}, measured {measured:?}"
+            ));
+        }
+    }
+    let heading = section.join(" ");
+    if !heading.contains(&format!("{}` {} bytes", sizes::DEVICE, s.topic)) {
+        wrong.push(format!("the DDATA topic: measured {} bytes", s.topic));
+    }
+    let births = format!(
+        "({:.1} KB per channel)",
+        (s.nbirth + s.dbirth) as f64 / 1000.0
+    );
+    if !doc.contains(&births) {
+        wrong.push(format!("births per channel: measured {births}"));
+    }
+    assert!(
+        wrong.is_empty(),
+        "docs/FLEET.md's message sizes are stale; write the measured ones (cargo bench --bench \
+         fleet prints them too):\n{}",
+        wrong.join("\n")
+    );
 }
