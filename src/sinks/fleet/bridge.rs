@@ -20,7 +20,7 @@
 //!    at most `WINDOW` unacknowledged at a time; a PUBACK acknowledges its record;
 //! 4. a lost connection ends the session: what was not acknowledged is sent again in the next
 //!    one (with the next `bdSeq`, a fresh NBIRTH/DBIRTH and new `seq` numbers), after a pause
-//!    that doubles from 1 s up to 30 s. rumqttc's own replay of unacknowledged packets is not
+//!    that doubles from 1 s up to 4 s (30 s after the broker refused the node). rumqttc's own replay of unacknowledged packets is not
 //!    used (a new client per session): its packets would carry the old session's `seq`;
 //! 5. with a primary host (`fleet.primary_host_id`), the births and step 3 wait until its STATE
 //!    says online, and stop while it says offline; the records wait in the queue meanwhile
