@@ -22,7 +22,10 @@
 //! Its ports are therefore of the `ipc_threadsafe` variant (the same shared memory as the
 //! subscribers' `ipc`), shared with a keeper thread: iceoryx2 hands the history to a new
 //! subscriber when the publisher next updates its connections, and the keeper does that every
-//! [`CONNECTION_PERIOD`], also while no alert is sent.
+//! [`CONNECTION_PERIOD`], also while no alert is sent. The keeper runs in SCHED_IDLE, so on a
+//! busy machine it may not run for a while; the publisher updates its connections once more
+//! when it finishes, so that a subscriber that connected meanwhile still gets the history
+//! before the service closes.
 
 use super::payload::Alert;
 pub use super::sequence::Received;
@@ -247,10 +250,14 @@ impl AlertPublisher {
         }
     }
 
-    /// Stops the keeper, closes the ports and reports.
+    /// Stops the keeper, hands the history to any subscriber the keeper has not served yet,
+    /// closes the ports and reports.
     pub fn finish(self) -> PublisherSummary {
         drop(self.stop_keeper);
         let _ = self.keeper.join();
+        if self.publisher.update_connections().is_ok() {
+            let _ = self.wake.notify();
+        }
         PublisherSummary {
             published: self.published,
             failed: self.failed,
