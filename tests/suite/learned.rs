@@ -64,6 +64,16 @@ fn a_tiny_training_run_learns_to_tell_faults_apart() {
         model.card.training.validation_accuracy
     );
     // Records it never saw (another seed and speed), one of each class.
+    let example = SimulationParams::example(SimulatedFault::None).bearing;
+    names_fresh_records_of_each_class(&model, &example);
+}
+
+/// `model` names outer race, inner race and healthy on records of `bearing` it never saw
+/// (another seed and speed than training's).
+fn names_fresh_records_of_each_class(
+    model: &LearnedModel,
+    bearing: &bearingd::bearing::BearingGeometry,
+) {
     for fault in [
         SimulatedFault::OuterRace,
         SimulatedFault::InnerRace,
@@ -72,14 +82,15 @@ fn a_tiny_training_run_learns_to_tell_faults_apart() {
         let params = SimulationParams {
             rpm: 1650.0,
             seed: 99,
+            bearing: bearing.clone(),
             ..SimulationParams::example(fault)
         };
         let samples = Simulator::record(params.clone(), 3.0);
         let opinion = model
             .opinion(&samples, params.fs_hz, params.rpm / 60.0, &params.bearing)
             .unwrap();
-        assert!(opinion.segments >= 3, "{opinion:?}");
-        assert_eq!(opinion.top().0, fault, "{opinion:?}");
+        assert!(opinion.segments >= 3, "{}: {opinion:?}", bearing.spec());
+        assert_eq!(opinion.top().0, fault, "{}: {opinion:?}", bearing.spec());
     }
 }
 
@@ -124,24 +135,7 @@ fn a_model_on_fault_relative_orders_trained_on_random_bearings_judges_a_bearing_
     // otherwise), each on records of another seed and speed.
     for bearing in ["rexnord-za-2115", "skf-61804"] {
         let geometry = bearingd::bearing::BearingGeometry::parse(bearing).unwrap();
-        for fault in [
-            SimulatedFault::OuterRace,
-            SimulatedFault::InnerRace,
-            SimulatedFault::None,
-        ] {
-            let params = SimulationParams {
-                rpm: 1650.0,
-                seed: 99,
-                bearing: geometry.clone(),
-                ..SimulationParams::example(fault)
-            };
-            let samples = Simulator::record(params.clone(), 3.0);
-            let opinion = model
-                .opinion(&samples, params.fs_hz, params.rpm / 60.0, &params.bearing)
-                .unwrap();
-            assert!(opinion.segments >= 3, "{opinion:?}");
-            assert_eq!(opinion.top().0, fault, "{bearing}: {opinion:?}");
-        }
+        names_fresh_records_of_each_class(&model, &geometry);
     }
 }
 
