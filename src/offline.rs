@@ -13,7 +13,7 @@ use crate::analysis::iso::{record_severity, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
 use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
 use crate::bearing::{BearingError, BearingGeometry};
-use crate::learned::{combined as combined_with_learned, LearnedModel, ModelError};
+use crate::learned::{combined as combined_with_learned, ModelError, ModelSet};
 use crate::messages::FaultKind;
 use crate::recording::{read_recording, ReadOptions, Recording, RecordingError, RecordingFormat};
 use crate::report::{AnalyzeReport, RecordContext, SpeedSource, TwinReport};
@@ -39,7 +39,8 @@ pub struct AnalyzeRequest {
     pub severity: SeveritySettings,
     /// A learned model's second opinion, combined with the envelope diagnosis
     /// (`analyze --learned`): the second witness of [`crate::analysis::agreement::decide`].
-    pub learned: Option<std::sync::Arc<LearnedModel>>,
+    /// One model per bearing: the record's is picked by its bearing.
+    pub learned: Option<std::sync::Arc<ModelSet>>,
 }
 
 /// Why a recording could not be analysed. Each message names the file and the fix.
@@ -320,13 +321,15 @@ pub fn analyze_recording(
     // before the report is made from it, so the report shows the band of what it names.
     let envelope_verdict = analysis.diagnosis.verdict;
     let learned = match &request.learned {
-        Some(model) => {
+        Some(models) => {
+            let learned_error = |source| OfflineError::Learned {
+                file: file.clone(),
+                source,
+            };
+            let model = models.for_bearing(&bearing).map_err(learned_error)?;
             let opinion = model
-                .opinion(&samples, fs_hz, rpm / 60.0, &bearing)
-                .map_err(|source| OfflineError::Learned {
-                    file: file.clone(),
-                    source,
-                })?;
+                .opinion_of_checked(&samples, fs_hz, &freqs)
+                .map_err(learned_error)?;
             analysis.hear_witness(opinion.as_witness(), &request.settings);
             Some((model, opinion))
         }

@@ -55,7 +55,8 @@ pub struct WitnessOpinion {
     pub probability: f64,
 }
 
-/// A second opinion of a signal, e.g. the learned model (`crate::learned::LearnedModel`).
+/// A second opinion of a signal, e.g. the learned models, one per bearing
+/// (`crate::learned::ModelSet`).
 pub trait Witness: Send + Sync + std::fmt::Debug {
     /// The opinion of `signal` (g, at `fs_hz`, the shaft and the faults at `freqs`);
     /// `Ok(None)` when it has none (the signal is too short for it), `Err` with why when it

@@ -68,9 +68,9 @@ pub struct AnalyzeArgs {
     /// twin's spectrum to the text and the plot).
     #[arg(long)]
     twin: bool,
-    /// Add a learned model's opinion (a .safetensors file of `bearingd train`; the shipped one
-    /// for the SKF 6205-2RS: models/skf-6205-2rs.safetensors). It may settle what the envelope
-    /// leaves open, never overrule it; the JSON gains `learned`.
+    /// Add a learned model's opinion: a .safetensors file of `bearingd train`, or a directory
+    /// of them, one per bearing (the shipped ones: models/, one for each catalog bearing). It
+    /// may settle what the envelope leaves open, never overrule it; the JSON gains `learned`.
     #[arg(long, conflicts_with = "hw")]
     learned: Option<PathBuf>,
     /// ISO 10816-3 machine group for the velocity zones: 1 (above 300 kW, or shaft height
@@ -161,7 +161,7 @@ pub fn run_with(args: &AnalyzeArgs, on_record: &mut OnRecord) -> Result<(), CliE
         .or(config.as_ref().and_then(|c| c.twin.learned_model.as_ref()));
     let learned = match learned_path {
         Some(path) => Some(std::sync::Arc::new(
-            crate::learned::LearnedModel::load(path).map_err(CliError::input)?,
+            crate::learned::ModelSet::load(path).map_err(CliError::input)?,
         )),
         None => None,
     };

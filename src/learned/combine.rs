@@ -2,14 +2,14 @@
 //! [`crate::analysis::agreement::decide`], never as a replacement.
 //!
 //! The decision itself lives in the analysis core, so that `analyze --learned`, the daemon's
-//! band job and `evaluate` make it with one function. Here: the learned model as a
-//! [`Witness`], and what the report says of the outcome ([`Combined`]): on what the verdict
-//! rests, and whether the network's most probable class is it.
+//! band job and `evaluate` make it with one function. Here: a model's opinion as the witness
+//! gives it (the models as a `Witness`: [`super::set`]), and what the report says of the
+//! outcome ([`Combined`]): on what the verdict rests, and whether the network's most probable
+//! class is it.
 
-use super::model::{LearnedModel, LearnedOpinion};
-use crate::analysis::agreement::{Witness, WitnessOpinion};
+use super::model::LearnedOpinion;
+use crate::analysis::agreement::WitnessOpinion;
 use crate::analysis::diagnosis::{Diagnosis, Named, Verdict};
-use crate::bearing::{BearingGeometry, FaultFrequencies};
 use serde::Serialize;
 
 impl LearnedOpinion {
@@ -22,23 +22,6 @@ impl LearnedOpinion {
                 probability,
             }
         })
-    }
-}
-
-impl Witness for LearnedModel {
-    fn witness(
-        &self,
-        signal: &[f32],
-        fs_hz: f64,
-        freqs: &FaultFrequencies,
-    ) -> Result<Option<WitnessOpinion>, String> {
-        self.opinion_of_checked(signal, fs_hz, freqs)
-            .map(|opinion| opinion.as_witness())
-            .map_err(|e| e.to_string())
-    }
-
-    fn knows(&self, bearing: &BearingGeometry) -> bool {
-        self.check_bearing(bearing).is_ok()
     }
 }
 

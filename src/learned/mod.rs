@@ -14,6 +14,7 @@
 //! - [`model`]: a trained model (weights + model card) and its opinion of a record;
 //! - `bearingd_lab::learned::train`: training on a data set, seeded, and writing the model file
 //!   (the lab crate: the service never trains);
+//! - [`set`]: the models to pick from, one per bearing (`twin.learned_model` as a directory);
 //! - [`combine`]: the model as that witness, and what the report says of the outcome.
 
 pub mod combine;
@@ -21,7 +22,9 @@ pub mod features;
 pub mod file;
 pub mod infer;
 pub mod model;
+pub mod set;
 
 pub use combine::{combined, Basis, Combined};
 pub use features::FeatureSettings;
 pub use model::{LearnedModel, LearnedOpinion, ModelCard, ModelError, TrainingSummary};
+pub use set::ModelSet;

@@ -60,6 +60,14 @@ pub enum ModelError {
         trained: String,
         given: String,
     },
+    #[error("{dir}: not a directory of models: {why}; give one model file, or a directory of model files (*.safetensors), one per bearing")]
+    NotAModelSet { dir: String, why: String },
+    #[error("{set}: no model for bearing {given} (it has models for: {known}); train one with `scripts/train_model.sh OUT.safetensors BEARING` into the directory, or remove twin.learned_model")]
+    NoModelFor {
+        set: String,
+        given: String,
+        known: String,
+    },
     #[error("{file}: cannot write: {why}")]
     Write { file: String, why: String },
 }
@@ -227,23 +235,7 @@ impl LearnedModel {
     /// geometry; its name may differ), unless the model reads fault-relative orders: then any
     /// geometry will do.
     pub fn check_bearing(&self, bearing: &BearingGeometry) -> Result<(), ModelError> {
-        if !self.card.features.axis.is_shaft() {
-            return Ok(());
-        }
-        let trained =
-            BearingGeometry::parse(&self.card.bearing).map_err(|e| ModelError::NotAModel {
-                file: self.file.clone(),
-                why: format!("its bearing {:?} does not parse: {e}", self.card.bearing),
-            })?;
-        let orders = |b: &BearingGeometry| {
-            let f = b.fault_frequencies(1.0);
-            [f.bpfo, f.bpfi, f.bsf, f.ftf]
-        };
-        let same = orders(&trained)
-            .iter()
-            .zip(orders(bearing))
-            .all(|(a, b)| (a - b).abs() <= 1e-3 * a.abs().max(1e-9));
-        if same {
+        if self.knows_orders(&bearing.fault_frequencies(1.0))? {
             Ok(())
         } else {
             Err(ModelError::OtherBearing {
@@ -252,6 +244,27 @@ impl LearnedModel {
                 given: bearing.spec(),
             })
         }
+    }
+
+    /// Whether the fault frequencies `freqs` (at any shaft speed) are those of the bearing the
+    /// model was trained on, within 0.1 % (always, for a model on fault-relative orders).
+    pub fn knows_orders(&self, freqs: &FaultFrequencies) -> Result<bool, ModelError> {
+        if !self.card.features.axis.is_shaft() {
+            return Ok(true);
+        }
+        let trained =
+            BearingGeometry::parse(&self.card.bearing).map_err(|e| ModelError::NotAModel {
+                file: self.file.clone(),
+                why: format!("its bearing {:?} does not parse: {e}", self.card.bearing),
+            })?;
+        let orders = |f: &FaultFrequencies| {
+            let shaft = f.shaft.max(1e-12);
+            [f.bpfo / shaft, f.bpfi / shaft, f.bsf / shaft, f.ftf / shaft]
+        };
+        Ok(orders(&trained.fault_frequencies(1.0))
+            .iter()
+            .zip(orders(freqs))
+            .all(|(a, b)| (a - b).abs() <= 1e-3 * a.abs().max(1e-9)))
     }
 }
 

@@ -8,7 +8,7 @@
 use super::TwinRequest;
 use crate::analysis::envelope::{window_samples, FftPlans};
 use crate::config::TwinConfig;
-use crate::learned::{LearnedModel, ModelError};
+use crate::learned::{ModelError, ModelSet};
 use crate::messages::{
     ChannelId, ClassProbability, HwMessage, LearnedOpinionMessage, PipelineMessage, TwinMessage,
 };
@@ -20,11 +20,11 @@ use std::sync::Arc;
 
 /// `twin.learned_model`, loaded once per process: the twin's re-fits log its opinion, and the
 /// band jobs' verdicts hear it as their second witness (`analysis.agreement_*`).
-pub fn load_learned(config: &TwinConfig) -> Result<Option<Arc<LearnedModel>>, ModelError> {
+pub fn load_learned(config: &TwinConfig) -> Result<Option<Arc<ModelSet>>, ModelError> {
     Ok(config
         .learned_model
         .as_deref()
-        .map(LearnedModel::load)
+        .map(ModelSet::load)
         .transpose()?
         .map(Arc::new))
 }
@@ -37,8 +37,8 @@ pub struct TwinWorker {
     /// The HW model's settings; `None`: off (`twin.hw_enabled = false`).
     hw: Option<HwSettings>,
     hw_trackers: BTreeMap<ChannelId, HwTracker>,
-    /// `twin.learned_model`, loaded.
-    learned: Option<Arc<LearnedModel>>,
+    /// `twin.learned_model`, loaded: a model per bearing.
+    learned: Option<Arc<ModelSet>>,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -53,9 +53,9 @@ const WINDOW_FRACTION: f64 = 0.25;
 
 impl TwinWorker {
     /// The worker, with the learned model (`twin.learned_model`, loaded once by the caller with
-    /// [`load_learned`]; its bearing was checked against the sensors' when the config was
+    /// [`load_learned`]; every sensor's bearing was found a model when the config was
     /// validated).
-    pub fn new(config: &TwinConfig, learned: Option<Arc<LearnedModel>>) -> Self {
+    pub fn new(config: &TwinConfig, learned: Option<Arc<ModelSet>>) -> Self {
         TwinWorker {
             plans: FftPlans::default(),
             fitter: TwinFitter::default(),
@@ -156,20 +156,19 @@ impl TwinWorker {
     /// evidence; `None` when no model is configured or the signal is shorter than a segment.
     fn learned_opinion(&self, request: &TwinRequest) -> Option<LearnedOpinionMessage> {
         let model = self.learned.as_ref()?;
-        let opinion =
-            match model.opinion_of_checked(&request.samples, request.fs_hz, &request.freqs) {
-                Ok(opinion) if opinion.segments > 0 => opinion,
-                Ok(_) => return None,
-                Err(e) => {
-                    return Some(LearnedOpinionMessage {
-                        segments: 0,
-                        probabilities: Vec::new(),
-                        confirms: None,
-                        agrees: false,
-                        problem: Some(e.to_string()),
-                    })
-                }
-            };
+        let opinion = match model.opinion_of(&request.samples, request.fs_hz, &request.freqs) {
+            Ok(opinion) if opinion.segments > 0 => opinion,
+            Ok(_) => return None,
+            Err(e) => {
+                return Some(LearnedOpinionMessage {
+                    segments: 0,
+                    probabilities: Vec::new(),
+                    confirms: None,
+                    agrees: false,
+                    problem: Some(e.to_string()),
+                })
+            }
+        };
         let top = opinion.top().0.kind();
         Some(LearnedOpinionMessage {
             segments: opinion.segments,

@@ -155,4 +155,34 @@ fn a_physics_dataset_is_made_and_a_bad_spec_lists_every_problem() {
         !dir.join("bad").exists(),
         "a refused spec must write nothing"
     );
+
+    // `--bearing` simulates another bearing with the same spec, says so in the spec.toml it
+    // writes, and is checked like the spec's own key.
+    let mut args = vec!["--bearing", "skf-6203-2rs"];
+    let spec = dir.join("physics.toml");
+    let with = |args: &[&str], out: &str| {
+        let mut all = vec!["dataset", "--spec", spec.to_str().unwrap(), "--out", out];
+        all.extend_from_slice(args);
+        bearingd(&all)
+    };
+    let other = dir.join("other-bearing");
+    let made = with(&args, other.to_str().unwrap());
+    assert!(made.status.success(), "{}", stderr(&made));
+    let written: toml::Table = std::fs::read_to_string(other.join("spec.toml"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert_eq!(
+        written["bearing"].as_str(),
+        Some("skf-6203-2rs"),
+        "{written}"
+    );
+    args[1] = "no-such-bearing";
+    let refused = with(&args, dir.join("refused").to_str().unwrap());
+    let err = stderr(&refused);
+    assert_eq!(refused.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--bearing \"no-such-bearing\"") && err.contains("skf-6203-2rs"),
+        "{err}"
+    );
 }

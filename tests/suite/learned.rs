@@ -9,7 +9,7 @@ use crate::dataset::make;
 use crate::developer_set::expected_class;
 use crate::replay::replay_json;
 use bearingd::analysis::record::RecordAnalyzer;
-use bearingd::learned::{Basis, LearnedModel};
+use bearingd::learned::{Basis, LearnedModel, ModelSet};
 use bearingd::mcap_log::read_messages;
 use bearingd::messages::{FaultKind, LearnedOpinionMessage, PipelineMessage};
 use bearingd::offline::{analyze, AnalyzeRequest};
@@ -70,7 +70,7 @@ fn a_tiny_training_run_learns_to_tell_faults_apart() {
 
 /// `model` names outer race, inner race and healthy on records of `bearing` it never saw
 /// (another seed and speed than training's).
-fn names_fresh_records_of_each_class(
+pub(crate) fn names_fresh_records_of_each_class(
     model: &LearnedModel,
     bearing: &bearingd::bearing::BearingGeometry,
 ) {
@@ -139,8 +139,8 @@ fn a_model_on_fault_relative_orders_trained_on_random_bearings_judges_a_bearing_
     }
 }
 
-fn shipped_model() -> Arc<LearnedModel> {
-    Arc::new(LearnedModel::load(&repo_root().join("models/skf-6205-2rs.safetensors")).unwrap())
+fn shipped_model() -> Arc<ModelSet> {
+    Arc::new(ModelSet::load(&repo_root().join("models/skf-6205-2rs.safetensors")).unwrap())
 }
 
 #[test]
@@ -224,17 +224,39 @@ fn a_model_file_that_does_not_apply_is_refused_with_the_fix() {
 /// opinion with every twin fit, and the flags stay the envelope's.
 #[test]
 fn the_daemon_logs_the_learned_opinion_with_each_twin_fit() {
-    let dir = scratch_dir("learned-daemon");
+    let model = repo_root().join("models/skf-6205-2rs.safetensors");
+    let opinions = replayed_opinions("learned-daemon", "skf-6205-2rs", &model);
+    for opinion in &opinions {
+        assert_eq!(
+            opinion.probabilities[0].fault,
+            Some(FaultKind::OuterRace),
+            "{opinion:?}"
+        );
+    }
+}
+
+/// The learned opinions a replay logs of a 30 s outer-race record of `bearing` (the signal
+/// model), with `learned_model = model` (a file or a directory): at least two, each without a
+/// problem and of at least one segment. The envelope must flag the outer race.
+pub(crate) fn replayed_opinions(
+    name: &str,
+    bearing: &str,
+    model: &std::path::Path,
+) -> Vec<LearnedOpinionMessage> {
+    let dir = scratch_dir(name);
     let one_record = TINY_SPEC
         .replace(
             "faults = [\"none\", \"outer_race\", \"inner_race\"]",
             "faults = [\"outer_race\"]",
         )
         .replace("records_per_fault = 20", "records_per_fault = 1")
-        .replace("duration_s = 2.0", "duration_s = 30.0");
+        .replace("duration_s = 2.0", "duration_s = 30.0")
+        .replace(
+            "bearing = \"skf-6205-2rs\"",
+            &format!("bearing = \"{bearing}\""),
+        );
     let set = make(&dir, "one", &one_record, true);
     let record = set.join("mcap/00000");
-    let model = repo_root().join("models/skf-6205-2rs.safetensors");
     let config = record.join("replay.toml");
     let text = std::fs::read_to_string(&config).unwrap();
     std::fs::write(
@@ -255,23 +277,23 @@ fn the_daemon_logs_the_learned_opinion_with_each_twin_fit() {
         .filter(|f| f["from"] == "ok")
         .map(|f| f["fault"].as_str().unwrap())
         .collect();
-    assert!(raised.contains(&"outer_race"), "{summary}");
+    assert!(raised.contains(&"outer_race"), "{bearing}: {summary}");
     let opinions: Vec<LearnedOpinionMessage> = read_messages(&mcap_files(&out))
         .filter_map(|m| match m.unwrap().message {
             PipelineMessage::Twin(t) => t.learned,
             _ => None,
         })
         .collect();
-    assert!(opinions.len() >= 2, "{} opinions logged", opinions.len());
+    assert!(
+        opinions.len() >= 2,
+        "{bearing}: {} opinions logged",
+        opinions.len()
+    );
     for opinion in &opinions {
-        assert!(opinion.problem.is_none(), "{opinion:?}");
-        assert_eq!(
-            opinion.probabilities[0].fault,
-            Some(FaultKind::OuterRace),
-            "{opinion:?}"
-        );
-        assert!(opinion.segments >= 1);
+        assert!(opinion.problem.is_none(), "{bearing}: {opinion:?}");
+        assert!(opinion.segments >= 1, "{bearing}: {opinion:?}");
     }
+    opinions
 }
 
 #[test]

@@ -18,6 +18,7 @@ mod hostile_files;
 mod hostile_logs;
 mod kinematics;
 mod learned;
+mod learned_models;
 mod machine;
 mod monitor;
 mod replay;

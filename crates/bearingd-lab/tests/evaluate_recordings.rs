@@ -9,7 +9,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use bearingd::analysis::agreement::Agreement;
-use bearingd::learned::LearnedModel;
+use bearingd::learned::ModelSet;
 use bearingd::messages::FaultKind;
 use bearingd::twin::{SimulatedFault, Simulator};
 use bearingd_lab::evaluate::outcome::Predicted;
@@ -393,7 +393,7 @@ fn with_the_learned_agreement_the_daemon_flags_what_analyze_names() {
             min_lead: 1.5,
             significance_relief_decades: 0.0,
         },
-        model: std::sync::Arc::new(LearnedModel::load(&model_path).unwrap()),
+        model: std::sync::Arc::new(ModelSet::load(&model_path).unwrap()),
         model_path,
     };
     let entries = run_agreeing(&manifest, &out, Some(agreement));

@@ -56,7 +56,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--band-selection', '--band-selection', [CompletionResultType]::ParameterName, 'How to choose the resonance band')
             [CompletionResult]::new('--band', '--band', [CompletionResultType]::ParameterName, 'The band for --band-selection fixed, as LO-HI in Hz, e.g. 2000-4000')
             [CompletionResult]::new('--window', '--window', [CompletionResultType]::ParameterName, 'Envelope-spectrum window length in seconds (rounded to a power of two samples)')
-            [CompletionResult]::new('--learned', '--learned', [CompletionResultType]::ParameterName, 'Add a learned model''s opinion (a .safetensors file of `bearingd train`; the shipped one for the SKF 6205-2RS: models/skf-6205-2rs.safetensors). It may settle what the envelope leaves open, never overrule it; the JSON gains `learned`')
+            [CompletionResult]::new('--learned', '--learned', [CompletionResultType]::ParameterName, 'Add a learned model''s opinion: a .safetensors file of `bearingd train`, or a directory of them, one per bearing (the shipped ones: models/, one for each catalog bearing). It may settle what the envelope leaves open, never overrule it; the JSON gains `learned`')
             [CompletionResult]::new('--machine-group', '--machine-group', [CompletionResultType]::ParameterName, 'ISO 10816-3 machine group for the velocity zones: 1 (above 300 kW, or shaft height from 315 mm) or 2 (15 to 300 kW, shaft height 160 to 315 mm)')
             [CompletionResult]::new('--foundation', '--foundation', [CompletionResultType]::ParameterName, 'Foundation for the velocity zones: rigid or flexible')
             [CompletionResult]::new('--hw-states', '--hw-states', [CompletionResultType]::ParameterName, 'With --hw: where the median filter sits in the virtual states'' chain of differences, raw_once (the raw signal, once: the seed''s reading) or each_order (every order''s output on its own); docs/HW.md compares them')
@@ -206,6 +206,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
         'bearingd;dataset' {
             [CompletionResult]::new('--spec', '--spec', [CompletionResultType]::ParameterName, 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml')
             [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/')
+            [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Simulate this bearing instead of the spec''s `bearing` (a catalog name or a custom geometry): one spec makes the training set of every bearing''s model. The spec.toml written beside the set says the bearing used')
             [CompletionResult]::new('--mcap', '--mcap', [CompletionResultType]::ParameterName, 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config')
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
             [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')

@@ -64,6 +64,7 @@ set edit:completion:arg-completer[bearingd-lab] = {|@words|
         &'bearingd-lab;dataset'= {
             cand --spec 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml'
             cand --out 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/'
+            cand --bearing 'Simulate this bearing instead of the spec''s `bearing` (a catalog name or a custom geometry): one spec makes the training set of every bearing''s model. The spec.toml written beside the set says the bearing used'
             cand --mcap 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config'
             cand -h 'Print help'
             cand --help 'Print help'
@@ -141,7 +142,7 @@ set edit:completion:arg-completer[bearingd-lab] = {|@words|
             cand --band-selection 'How to choose the resonance band'
             cand --band 'The band for --band-selection fixed, as LO-HI in Hz, e.g. 2000-4000'
             cand --window 'Envelope-spectrum window length in seconds (rounded to a power of two samples)'
-            cand --learned 'Add a learned model''s opinion (a .safetensors file of `bearingd train`; the shipped one for the SKF 6205-2RS: models/skf-6205-2rs.safetensors). It may settle what the envelope leaves open, never overrule it; the JSON gains `learned`'
+            cand --learned 'Add a learned model''s opinion: a .safetensors file of `bearingd train`, or a directory of them, one per bearing (the shipped ones: models/, one for each catalog bearing). It may settle what the envelope leaves open, never overrule it; the JSON gains `learned`'
             cand --machine-group 'ISO 10816-3 machine group for the velocity zones: 1 (above 300 kW, or shaft height from 315 mm) or 2 (15 to 300 kW, shaft height 160 to 315 mm)'
             cand --foundation 'Foundation for the velocity zones: rigid or flexible'
             cand --hw-states 'With --hw: where the median filter sits in the virtual states'' chain of differences, raw_once (the raw signal, once: the seed''s reading) or each_order (every order''s output on its own); docs/HW.md compares them'

@@ -58,7 +58,7 @@ gk\t''
 fixed\t''"
 complete -c bearingd -n "__fish_bearingd_using_subcommand analyze" -l band -d 'The band for --band-selection fixed, as LO-HI in Hz, e.g. 2000-4000' -r
 complete -c bearingd -n "__fish_bearingd_using_subcommand analyze" -l window -d 'Envelope-spectrum window length in seconds (rounded to a power of two samples)' -r
-complete -c bearingd -n "__fish_bearingd_using_subcommand analyze" -l learned -d 'Add a learned model\'s opinion (a .safetensors file of `bearingd train`; the shipped one for the SKF 6205-2RS: models/skf-6205-2rs.safetensors). It may settle what the envelope leaves open, never overrule it; the JSON gains `learned`' -r -F
+complete -c bearingd -n "__fish_bearingd_using_subcommand analyze" -l learned -d 'Add a learned model\'s opinion: a .safetensors file of `bearingd train`, or a directory of them, one per bearing (the shipped ones: models/, one for each catalog bearing). It may settle what the envelope leaves open, never overrule it; the JSON gains `learned`' -r -F
 complete -c bearingd -n "__fish_bearingd_using_subcommand analyze" -l machine-group -d 'ISO 10816-3 machine group for the velocity zones: 1 (above 300 kW, or shaft height from 315 mm) or 2 (15 to 300 kW, shaft height 160 to 315 mm)' -r
 complete -c bearingd -n "__fish_bearingd_using_subcommand analyze" -l foundation -d 'Foundation for the velocity zones: rigid or flexible' -r -f -a "rigid\t''
 flexible\t''"
@@ -161,6 +161,7 @@ complete -c bearingd -n "__fish_bearingd_using_subcommand simulate" -l nuisance 
 complete -c bearingd -n "__fish_bearingd_using_subcommand simulate" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -l spec -d 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml' -r -F
 complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -l out -d 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/' -r -F
+complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -l bearing -d 'Simulate this bearing instead of the spec\'s `bearing` (a catalog name or a custom geometry): one spec makes the training set of every bearing\'s model. The spec.toml written beside the set says the bearing used' -r
 complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -l mcap -d 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config'
 complete -c bearingd -n "__fish_bearingd_using_subcommand dataset" -s h -l help -d 'Print help'
 complete -c bearingd -n "__fish_bearingd_using_subcommand train" -l dataset -d 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes, and same bearing on shaft orders), e.g. a signal-model and a physics set' -r -F

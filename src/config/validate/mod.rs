@@ -65,7 +65,7 @@ pub(crate) fn validate(raw: &RawConfig) -> Result<Config, Vec<ConfigProblem>> {
                 "analysis.agreement_probability",
                 "the learned model's agreement has no model to agree with; set \
                  twin.learned_model, e.g. learned_model = \
-                 \"/usr/share/bearingd/skf-6205-2rs.safetensors\", or remove the agreement_* keys",
+                 \"/usr/share/bearingd/models\", or remove the agreement_* keys",
             );
         }
     }

@@ -61,20 +61,21 @@ impl Checker {
         })
     }
 
-    /// The learned model must load and know every sensor's bearing.
+    /// The learned model (a file, or a directory of one model per bearing) must load and
+    /// have a model for every sensor's bearing.
     fn learned_model(
         &mut self,
         field: &Field<String>,
         sensors: &[CheckedSensor],
     ) -> Option<Option<PathBuf>> {
         let key = "twin.learned_model";
-        let fix = "give a model file of `bearingd train`, e.g. learned_model = \
-                   \"/usr/share/bearingd/skf-6205-2rs.safetensors\", or remove the key";
+        let fix = "give a model file of `bearingd train` or a directory of them, e.g. \
+                   learned_model = \"/usr/share/bearingd/models\", or remove the key";
         let Some(path) = self.optional_text(key, field, fix)?.map(PathBuf::from) else {
             return Some(None);
         };
-        let model = match crate::learned::LearnedModel::load(&path) {
-            Ok(model) => model,
+        let models = match crate::learned::ModelSet::load(&path) {
+            Ok(models) => models,
             Err(e) => {
                 self.problem(key, format!("{e}"));
                 return None;
@@ -82,7 +83,7 @@ impl Checker {
         };
         let mut fits = true;
         for sensor in sensors.iter().filter_map(|s| s.config.as_ref()) {
-            if let Err(e) = model.check_bearing(&sensor.bearing) {
+            if let Err(e) = models.for_bearing(&sensor.bearing) {
                 self.problem(key, format!("sensor {}: {e}", sensor.id));
                 fits = false;
             }

@@ -27,19 +27,42 @@ pub struct DatasetArgs {
     /// Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config.
     #[arg(long)]
     mcap: bool,
+    /// Simulate this bearing instead of the spec's `bearing` (a catalog name or a custom
+    /// geometry): one spec makes the training set of every bearing's model. The spec.toml
+    /// written beside the set says the bearing used.
+    #[arg(long)]
+    bearing: Option<String>,
 }
 
 pub fn run(args: &DatasetArgs) -> Result<(), CliError> {
     let text = std::fs::read_to_string(&args.spec)
         .map_err(|e| CliError::input(format!("{}: cannot read: {e}", args.spec.display())))?;
-    let spec = DatasetSpec::parse(&text).map_err(|problems| {
-        CliError::input(format!(
-            "{}: {} problem(s): {}",
-            args.spec.display(),
-            problems.len(),
-            problems.join("; ")
-        ))
-    })?;
+    let parse = |text: &str| {
+        DatasetSpec::parse(text).map_err(|problems| {
+            CliError::input(format!(
+                "{}{}: {} problem(s): {}",
+                args.spec.display(),
+                match &args.bearing {
+                    Some(b) => format!(" with --bearing {b:?}"),
+                    None => String::new(),
+                },
+                problems.len(),
+                problems.join("; ")
+            ))
+        })
+    };
+    let mut spec = parse(&text)?;
+    // The spec as used: with another bearing, the spec rewritten (and checked again).
+    let text = match &args.bearing {
+        Some(bearing) => {
+            spec.bearing = bearing.clone();
+            let rewritten = toml::to_string(&spec)
+                .map_err(|e| CliError::failure(format!("the spec with --bearing: {e}")))?;
+            spec = parse(&rewritten)?;
+            rewritten
+        }
+        None => text,
+    };
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::input(format!("{}: cannot create: {e}", args.out.display())))?;
     let records = spec.records();

@@ -51,7 +51,7 @@ use crate::recording::{
 };
 use crate::sinks::mcap::raw_log::{import_recording, Import, LogSignal};
 use crate::sources::replay::plan::{LoggedSettings, ReplayPlan};
-use bearingd::learned::{LearnedModel, ModelError};
+use bearingd::learned::{ModelError, ModelSet};
 use bearingd::report::SpeedSource;
 use serde::Serialize;
 use std::io::Read;
@@ -80,7 +80,7 @@ pub struct RecordingsAgreement {
     pub agreement: Agreement,
     /// The model file, for the replay's config.
     pub model_path: PathBuf,
-    pub model: Arc<LearnedModel>,
+    pub model: Arc<ModelSet>,
 }
 
 impl RecordingsAgreement {
@@ -92,7 +92,7 @@ impl RecordingsAgreement {
         else {
             return Ok(None);
         };
-        let model = Arc::new(LearnedModel::load(&model_path)?);
+        let model = Arc::new(ModelSet::load(&model_path)?);
         Ok(Some(RecordingsAgreement {
             agreement,
             model_path,
