@@ -344,6 +344,37 @@ fn missing_manifests_and_files_are_said_and_fail_under_strict() {
     let stderr = String::from_utf8_lossy(&strict.stderr);
     assert_eq!(strict.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("1 failed record(s)"), "{stderr}");
+
+    // --config (its agreement and models, here the shipped directory) goes with --recordings;
+    // a config that does not load stops the run naming it.
+    let config = dir.join("agreement.toml");
+    std::fs::write(
+        &config,
+        format!(
+            "[[sensors]]\nid = \"s\"\ntransport = \"sim\"\nsample_rate_hz = 12000\nbearing = \"skf-6203-2rs\"\n[sensors.speed]\nsource = \"fixed\"\nrpm = 1800\n[analysis]\nagreement_probability = 0.9\nagreement_fault_score = 2.5\nagreement_score_ratio = 1.5\nagreement_significance_relief = 0.0\n[twin]\nlearned_model = \"{}\"\n",
+            bearingd_testdata::repo_root().join("models").display()
+        ),
+    )
+    .unwrap();
+    let configured = lab(&[&args[..], &["--config", config.to_str().unwrap()]].concat());
+    let stdout = String::from_utf8_lossy(&configured.stdout);
+    let stderr = String::from_utf8_lossy(&configured.stderr);
+    assert_eq!(configured.status.code(), Some(0), "{stderr}");
+    assert!(stdout.contains("file not found"), "{stdout}");
+    let text = std::fs::read_to_string(&config).unwrap();
+    let models = bearingd_testdata::repo_root().join("models");
+    std::fs::write(
+        &config,
+        text.replace(models.to_str().unwrap(), "/nonexistent/models"),
+    )
+    .unwrap();
+    let refused = lab(&[&args[..], &["--config", config.to_str().unwrap()]].concat());
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("agreement.toml") && stderr.contains("/nonexistent/models"),
+        "{stderr}"
+    );
 }
 
 /// With the learned model's agreement (issue 30 item 3) `analyze` and the daemon decide with

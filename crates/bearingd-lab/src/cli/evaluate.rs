@@ -30,7 +30,7 @@ pub struct EvaluateArgs {
     /// relative to its folder, and `fault`, `note` or `life_frac` for the truth; `channel_var`,
     /// `fs_hz`, `rpm`, `bearing_geometry` where the file does not say) through `bearingd analyze` and through
     /// `bearingd import` + `replay`; writes recordings.json. May be given several times.
-    #[arg(long, value_name = "MANIFEST", conflicts_with_all = ["quick", "config", "no_nuisance"])]
+    #[arg(long, value_name = "MANIFEST", conflicts_with_all = ["quick", "no_nuisance"])]
     recordings: Vec<PathBuf>,
     /// Instead of the sweep: H hours of healthy simulated signal per machine (the full sweep's
     /// three machines at 0.6 and 1 × nominal speed, four noise levels, with the nuisance)
