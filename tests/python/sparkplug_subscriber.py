@@ -10,6 +10,11 @@ The rules checked (each break is listed under "violations"):
 - within a session every DBIRTH/DDATA/DDEATH has the seq after the previous message's (mod 256);
 - a DDATA comes from a device born in the session and not dead since, and names only metrics
   of that device's DBIRTH, each with the datatype declared there;
+- aliases: every metric of an NBIRTH or DBIRTH has a name and an alias, the aliases of a node's
+  births are unique within the node (a rebirth starts afresh; a device born again replaces its
+  own); a DDATA metric carries an alias and no name, and the alias is one its device's DBIRTH
+  of the same session declared. The host names DDATA metrics by those aliases, so the JSON
+  lines and the checks below see names;
 - an NDEATH carries the bdSeq of the session's NBIRTH.
 
 The session is persistent (clean_session false, QoS 1) and the test broker queues QoS 0 messages
@@ -84,15 +89,19 @@ def metric_value(m):
 def decode(payload_cls, topic, raw, received_ms):
     parts = topic.split("/")
     payload = payload_cls.FromString(raw)
-    metrics = {}
+    metrics = []
     for m in payload.metrics:
-        metrics[m.name] = {
-            "value": metric_value(m),
-            "datatype": m.datatype,
-            "timestamp": m.timestamp,
-            "historical": m.is_historical,
-            "null": m.is_null,
-        }
+        metrics.append(
+            {
+                "name": m.name if m.HasField("name") else None,
+                "alias": m.alias if m.HasField("alias") else None,
+                "value": metric_value(m),
+                "datatype": m.datatype,
+                "timestamp": m.timestamp,
+                "historical": m.is_historical,
+                "null": m.is_null,
+            }
+        )
     return {
         "topic": topic,
         "group": parts[1] if len(parts) > 1 else None,
@@ -103,7 +112,7 @@ def decode(payload_cls, topic, raw, received_ms):
         "timestamp": payload.timestamp if payload.HasField("timestamp") else None,
         "received_ms": received_ms,
         "bytes": len(raw),
-        "metrics": metrics,
+        "metrics": metrics,  # a list until Checker.take names them (by alias in DDATA)
     }
 
 
@@ -117,13 +126,72 @@ class Checker:
         self.deaths = []  # (node, bdSeq, matched)
         self.device_deaths = []
         self.records = []  # one per DDATA carrying bearingd/Record
+        # What the alias checks saw: births whose metrics all had aliases, DDATA metrics named
+        # by a declared alias.
+        self.aliases = {"births": 0, "declared": 0, "ddata_metrics": 0}
 
     def violation(self, msg, text):
         self.violations.append(f"{msg['topic']} seq {msg['seq']}: {text}")
 
+    def declare(self, msg, state):
+        """A birth's aliases into the node's map (alias -> (device, name))."""
+        device = msg["device"]
+        aliases = state["aliases"]
+        for alias in [a for a, (d, _) in aliases.items() if d == device]:
+            del aliases[alias]  # a device born again declares its own anew
+        complete = True
+        for m in msg["metrics"]:
+            if m["name"] is None:
+                self.violation(msg, f"a birth metric without a name (alias {m['alias']})")
+                complete = False
+            elif m["alias"] is None:
+                self.violation(msg, f"birth metric {m['name']!r} without an alias")
+                complete = False
+            elif m["alias"] in aliases:
+                owner = aliases[m["alias"]]
+                self.violation(
+                    msg, f"alias {m['alias']} of {m['name']!r} already declared for {owner}"
+                )
+                complete = False
+            else:
+                aliases[m["alias"]] = (device, m["name"])
+                self.aliases["declared"] += 1
+        self.aliases["births"] += complete
+
+    def name_metrics(self, msg, state):
+        """The message's metric list as a dict by name; DDATA's names from their aliases."""
+        named = {}
+        for m in msg["metrics"]:
+            name = m["name"]
+            if msg["type"] == "DDATA":
+                if name is not None:
+                    self.violation(msg, f"DDATA metric {name!r} carries its name")
+                if m["alias"] is None:
+                    self.violation(msg, f"DDATA metric {name!r} without an alias")
+                elif state is not None:
+                    device, declared = state["aliases"].get(m["alias"], (None, None))
+                    if declared is None or device != msg["device"]:
+                        self.violation(
+                            msg,
+                            f"DDATA alias {m['alias']} is not declared by the device's DBIRTH",
+                        )
+                    elif name is None:
+                        name = declared
+                        self.aliases["ddata_metrics"] += 1
+            if name is None:
+                name = f"#{m['alias']}"
+            named[name] = m
+        msg["metrics"] = named
+
     def take(self, msg):
         kind, node = msg["type"], (msg["group"], msg["node"])
         state = self.nodes.get(node)
+        if kind in ("NBIRTH", "DBIRTH"):
+            if kind == "NBIRTH":
+                state = {"bd_seq": None, "seq": 0, "devices": {}, "aliases": {}}
+            if state is not None:
+                self.declare(msg, state)
+        self.name_metrics(msg, state)
         if kind == "NBIRTH":
             bd = msg["metrics"].get("bdSeq")
             if msg["seq"] != 0:
@@ -135,7 +203,8 @@ class Checker:
                 self.violation(msg, f"NBIRTH without a Boolean {REBIRTH!r} metric")
             bd_seq = bd["value"] if bd else None
             self.births.append([msg["node"], bd_seq])
-            self.nodes[node] = {"bd_seq": bd_seq, "seq": 0, "devices": {}}
+            state["bd_seq"] = bd_seq
+            self.nodes[node] = state
             return
         if kind == "NDEATH":
             bd = msg["metrics"].get("bdSeq")
@@ -228,6 +297,7 @@ class Checker:
             "deaths": self.deaths,
             "device_deaths": self.device_deaths,
             "rebirth_sent": rebirth_sent,
+            "aliases": self.aliases,
             "records": {
                 "count": len(unique),
                 "first": unique[0] if unique else None,

@@ -440,6 +440,11 @@ impl MetricBook {
     pub fn metric_count(&self) -> usize {
         self.catalog.names.len()
     }
+
+    /// A metric's position in the catalog (the order of [`MetricBook::birth_metrics`]).
+    pub fn metric_index(&self, name: &str) -> Option<usize> {
+        self.catalog.names.iter().position(|(n, _)| n == name)
+    }
 }
 
 #[cfg(test)]

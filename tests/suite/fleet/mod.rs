@@ -46,6 +46,37 @@ fn assert_no_violations(summary: &Value) {
     );
 }
 
+/// Metric aliases (issue 33): the host's violations hold the breaks (a birth metric without an
+/// alias, an alias declared twice in a node, a DDATA metric with a name or an alias its DBIRTH
+/// did not declare); this holds that the checks ran over every birth and every DDATA metric,
+/// three sessions' worth here (the first, the rebirth, the restart).
+fn assert_aliases_checked(summary: &Value, messages: &[Value]) {
+    let aliases = &summary["aliases"];
+    let counts = &summary["counts"];
+    let births = counts["NBIRTH"].as_u64().unwrap_or(0) + counts["DBIRTH"].as_u64().unwrap_or(0);
+    assert!(births >= 6, "{counts}");
+    assert_eq!(
+        aliases["births"], births,
+        "births with every metric aliased: {aliases}"
+    );
+    let data = of_type(messages, "DDATA");
+    let mut by_alias = 0;
+    for d in &data {
+        for (name, m) in d["metrics"].as_object().unwrap() {
+            assert!(
+                m["name"].is_null() && m["alias"].is_u64() && !name.starts_with('#'),
+                "a DDATA metric not carried by a declared alias alone: {name} {m} in {d}"
+            );
+            by_alias += 1;
+        }
+    }
+    assert!(data.len() >= 6, "{counts}");
+    assert!(
+        aliases["ddata_metrics"].as_u64() >= Some(by_alias),
+        "{aliases}"
+    );
+}
+
 #[test]
 fn birth_data_rebirth_and_death_on_kill_9_then_a_restart_and_a_clean_stop() {
     let Some(setup) = NodeSetup::prepare("fleet-life") else {
@@ -159,9 +190,11 @@ fn birth_data_rebirth_and_death_on_kill_9_then_a_restart_and_a_clean_stop() {
         of_type(m, "NDEATH").len() >= 2
     });
     assert!(!of_type(&messages, "DDEATH").is_empty());
+    let host_messages = messages;
 
     let summary = host.finish();
     assert_no_violations(&summary);
+    assert_aliases_checked(&summary, &host_messages);
     let births = births_of(&summary, "press-7");
     assert_eq!(births.len(), 3, "{}", summary["births"]);
     assert_eq!(births[1], births[0], "a rebirth keeps the bdSeq");
