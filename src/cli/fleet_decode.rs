@@ -3,9 +3,12 @@
 //! ```text
 //! mosquitto_sub -h BROKER -t 'spBv1.0/#' -F '%t %x' | bearingd fleet-decode
 //! ```
+//!
+//! DDATA names its metrics by alias: started after a node's births, it prints `#<alias>` until
+//! the next rebirth declares the names.
 
 use super::CliError;
-use crate::sinks::fleet::decode::decode_line;
+use crate::sinks::fleet::decode::Decoder;
 use clap::Args;
 use std::io::{BufRead, Write};
 
@@ -20,12 +23,13 @@ pub fn run(args: &FleetDecodeArgs) -> Result<(), CliError> {
     let stdin = std::io::stdin();
     let mut stdout = std::io::stdout().lock();
     let mut bad = 0u64;
+    let mut decoder = Decoder::new();
     for (n, line) in stdin.lock().lines().enumerate() {
         let line = line.map_err(|e| CliError::failure(format!("stdin: {e}")))?;
         if line.trim().is_empty() {
             continue;
         }
-        match decode_line(&line) {
+        match decoder.decode_line(&line) {
             Ok(json) => {
                 let text = if args.pretty {
                     serde_json::to_string_pretty(&json)
