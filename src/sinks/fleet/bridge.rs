@@ -103,6 +103,8 @@ pub struct BridgeSummary {
     pub sessions: u64,
     /// Records of devices no longer configured, found in the queue and skipped.
     pub stale_records: u64,
+    /// Queued metrics no birth of this version declares, left out of their DDATA.
+    pub left_out_metrics: u64,
     pub bd_seq: u64,
     /// What the primary host's STATE messages did (`fleet.primary_host_id` set).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -722,6 +724,15 @@ impl Bridge {
             (self.notices)(format!("fleet: queue: {e}"));
         }
         self.summary.queue = self.queue.stats();
+        self.summary.left_out_metrics = self.node.left_out_metrics();
+        if self.summary.stale_records + self.summary.left_out_metrics > 0 {
+            (self.notices)(format!(
+                "fleet: from the queue, {} records of devices no longer configured skipped and \
+                 {} metrics this version does not declare left out of their DDATA (records of \
+                 another config or bearingd version)",
+                self.summary.stale_records, self.summary.left_out_metrics
+            ));
+        }
         if let Some(primary) = &self.primary {
             let h = primary.stats();
             (self.notices)(format!(

@@ -94,6 +94,9 @@ pub struct EdgeNode {
     born: Vec<bool>,
     /// Node metrics beyond the required ones, for the NBIRTH (name, value).
     properties: Vec<(String, Value)>,
+    /// Queued metrics left out of their DDATA because no birth declares them (records of
+    /// another bearingd version): counted, for the stop summary.
+    left_out_metrics: u64,
 }
 
 impl EdgeNode {
@@ -106,6 +109,7 @@ impl EdgeNode {
             next_seq: 0,
             born: vec![false; devices],
             properties: Vec::new(),
+            left_out_metrics: 0,
         }
     }
 
@@ -299,6 +303,7 @@ impl EdgeNode {
         let lost = payload.metrics.iter().any(|m| {
             m.name.as_deref() == Some("Sensor/Lost") && m.value() == Some(Value::Boolean(true))
         });
+        let queued = payload.metrics.len();
         payload.metrics.retain_mut(|m| {
             let index = m.name.as_deref().and_then(|name| book.metric_index(name));
             m.alias = index.map(|i| self.device_alias(book, device, i));
@@ -306,6 +311,7 @@ impl EdgeNode {
             m.is_historical = historical.then_some(true);
             index.is_some()
         });
+        self.left_out_metrics += (queued - payload.metrics.len()) as u64;
         let mut numbered = Metric::named(
             RECORD,
             DataType::UInt64,
@@ -338,6 +344,11 @@ impl EdgeNode {
             .collect();
         out.push(self.death(now_ms));
         out
+    }
+
+    /// Queued metrics left out of their DDATA so far, since no birth declares them.
+    pub fn left_out_metrics(&self) -> u64 {
+        self.left_out_metrics
     }
 
     /// Reads an NCMD payload; the rebirth metric may be named or go by its alias.
@@ -657,6 +668,7 @@ mod tests {
                 .unwrap(),
         );
         assert_eq!(data.metrics.len(), record.payload.metrics.len());
+        assert_eq!(node.left_out_metrics(), 1);
         assert!(data
             .metrics
             .iter()
