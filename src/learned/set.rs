@@ -54,15 +54,18 @@ impl ModelSet {
             if file.extension().is_some_and(|e| e == "safetensors") {
                 files.push(file);
             }
+            if files.len() > MAX_MODELS {
+                break;
+            }
         }
         files.sort();
         if files.is_empty() || files.len() > MAX_MODELS {
             return Err(ModelError::NotAModelSet {
                 dir: source,
-                why: format!(
-                    "it holds {} *.safetensors files (1 to {MAX_MODELS} wanted)",
-                    files.len()
-                ),
+                why: match files.len() {
+                    0 => "it holds no *.safetensors file".to_string(),
+                    _ => format!("it holds more than {MAX_MODELS} *.safetensors files"),
+                },
             });
         }
         let models = files

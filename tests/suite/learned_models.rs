@@ -142,7 +142,7 @@ fn a_model_directory_serves_sensors_of_several_bearings_and_is_refused_with_the_
     let out = validate(&dir, &["skf-6205-2rs"], &empty);
     let err = stderr(&out);
     assert!(
-        !out.status.success() && err.contains("holds 0 *.safetensors files"),
+        !out.status.success() && err.contains("holds no *.safetensors file"),
         "{err}"
     );
 }
