@@ -210,10 +210,7 @@ fn birth_data_rebirth_and_death_on_kill_9_then_a_restart_and_a_clean_stop() {
         "each NDEATH carries its session's bdSeq: {deaths:?}"
     );
     // Across the kill, nothing the queue held is missing.
-    let records = &summary["records"];
-    assert_eq!(records["first"], 0, "{records}");
-    assert_eq!(records["missing"], serde_json::json!([]), "{records}");
-    assert_eq!(records["out_of_order"], serde_json::json!([]), "{records}");
+    assert_records_complete_in_order(&summary["records"], 0);
     drop(broker);
 }
 
@@ -359,13 +356,7 @@ fn store_and_forward_through_a_broker_restart_a_60_s_outage_and_a_kill_9() {
         "the returning broker was used only {} ms after it came back (at most 5 s)",
         first_back_ms - up_ms
     );
-    assert_eq!(records["first"], 0, "{records}");
-    assert_eq!(
-        records["missing"],
-        serde_json::json!([]),
-        "records lost: {records}"
-    );
-    assert_eq!(records["out_of_order"], serde_json::json!([]), "{records}");
+    assert_records_complete_in_order(records, 0);
     let list = summary["record_list"].as_array().unwrap();
     let during_outage: Vec<&Value> = list
         .iter()
@@ -587,13 +578,7 @@ fn with_a_primary_host_nothing_is_published_while_it_is_offline_and_nothing_is_l
         "one MQTT session: the rebirth keeps the bdSeq"
     );
     let records = &summary["records"];
-    assert_eq!(records["first"], 0, "{records}");
-    assert_eq!(
-        records["missing"],
-        serde_json::json!([]),
-        "records lost: {records}"
-    );
-    assert_eq!(records["out_of_order"], serde_json::json!([]), "{records}");
+    assert_records_complete_in_order(records, 0);
     assert_eq!(records["resent"], serde_json::json!([]), "{records}");
     // What waited for the host is marked historical, both times.
     assert!(
@@ -681,4 +666,15 @@ fn the_documented_message_sizes_are_the_measured_ones() {
          fleet prints them too):\n{}",
         wrong.join("\n")
     );
+}
+
+/// The test host's `records` summary: numbered from `first`, none missing, none out of order.
+fn assert_records_complete_in_order(records: &Value, first: u64) {
+    assert_eq!(records["first"], first, "{records}");
+    assert_eq!(
+        records["missing"],
+        serde_json::json!([]),
+        "records lost: {records}"
+    );
+    assert_eq!(records["out_of_order"], serde_json::json!([]), "{records}");
 }
