@@ -1,6 +1,6 @@
 //! The learned models a daemon or an analysis picks from, by bearing: `twin.learned_model`
 //! (or `analyze --learned`) names one model file, or a directory of them, one per bearing
-//! (the package ships one for each catalog bearing in `/usr/share/bearingd/models/`).
+//! (the repository's `models/` has one for each catalog bearing).
 //!
 //! A model on shaft orders knows one geometry's fault orders, so each channel is judged by the
 //! model of its own bearing; a model on fault-relative orders serves any bearing that has no
