@@ -107,14 +107,11 @@ impl ModelSet {
     /// The model whose bearing has the fault frequencies `freqs` (at any shaft speed), as in
     /// [`Self::for_bearing`].
     pub fn for_frequencies(&self, freqs: &FaultFrequencies) -> Option<&LearnedModel> {
-        let knows = |m: &&LearnedModel| m.knows_orders(freqs).unwrap_or(false);
-        let (own, any): (Vec<&LearnedModel>, Vec<&LearnedModel>) = self
-            .models
+        let shaft = |m: &&LearnedModel| m.card.features.axis.is_shaft();
+        self.models
             .iter()
-            .partition(|m| m.card.features.axis.is_shaft());
-        own.into_iter()
-            .find(knows)
-            .or_else(|| any.into_iter().next())
+            .find(|m| shaft(m) && m.knows_orders(freqs).unwrap_or(false))
+            .or_else(|| self.models.iter().find(|m| !shaft(m)))
     }
 
     /// The opinion of `samples` (at `fs_hz`) by the model of the bearing whose frequencies
