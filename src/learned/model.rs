@@ -77,6 +77,9 @@ pub struct LearnedModel {
     /// Where it was read from (`trained` for a model fresh from training).
     pub file: String,
     weights: Weights,
+    /// The fault orders of the bearing a shaft-order model was trained on (read from the card
+    /// once, at load); `None` for a model on fault-relative orders, which serves any bearing.
+    trained_orders: Option<[f64; 4]>,
 }
 
 impl std::fmt::Debug for LearnedModel {
@@ -122,6 +125,17 @@ impl LearnedModel {
             file: file.clone(),
             why,
         };
+        let trained_orders = if card.features.axis.is_shaft() {
+            let trained = BearingGeometry::parse(&card.bearing).map_err(|e| {
+                not_a_model(format!(
+                    "its bearing {:?} does not parse: {e}",
+                    card.bearing
+                ))
+            })?;
+            Some(fault_orders(&trained.fault_frequencies(1.0)))
+        } else {
+            None
+        };
         let weights = Weights::from_tensors(
             bins,
             card.classes.len(),
@@ -139,6 +153,7 @@ impl LearnedModel {
             card,
             file,
             weights,
+            trained_orders,
         })
     }
 
@@ -235,7 +250,7 @@ impl LearnedModel {
     /// geometry; its name may differ), unless the model reads fault-relative orders: then any
     /// geometry will do.
     pub fn check_bearing(&self, bearing: &BearingGeometry) -> Result<(), ModelError> {
-        if self.knows_orders(&bearing.fault_frequencies(1.0))? {
+        if self.knows_orders(&bearing.fault_frequencies(1.0)) {
             Ok(())
         } else {
             Err(ModelError::OtherBearing {
@@ -248,24 +263,20 @@ impl LearnedModel {
 
     /// Whether the fault frequencies `freqs` (at any shaft speed) are those of the bearing the
     /// model was trained on, within 0.1 % (always, for a model on fault-relative orders).
-    pub fn knows_orders(&self, freqs: &FaultFrequencies) -> Result<bool, ModelError> {
-        if !self.card.features.axis.is_shaft() {
-            return Ok(true);
-        }
-        let trained =
-            BearingGeometry::parse(&self.card.bearing).map_err(|e| ModelError::NotAModel {
-                file: self.file.clone(),
-                why: format!("its bearing {:?} does not parse: {e}", self.card.bearing),
-            })?;
-        let orders = |f: &FaultFrequencies| {
-            let shaft = f.shaft.max(1e-12);
-            [f.bpfo / shaft, f.bpfi / shaft, f.bsf / shaft, f.ftf / shaft]
-        };
-        Ok(orders(&trained.fault_frequencies(1.0))
-            .iter()
-            .zip(orders(freqs))
-            .all(|(a, b)| (a - b).abs() <= 1e-3 * a.abs().max(1e-9)))
+    pub fn knows_orders(&self, freqs: &FaultFrequencies) -> bool {
+        self.trained_orders.is_none_or(|trained| {
+            trained
+                .iter()
+                .zip(fault_orders(freqs))
+                .all(|(a, b)| (a - b).abs() <= 1e-3 * a.abs().max(1e-9))
+        })
     }
+}
+
+/// The faults' frequencies as orders of the shaft (BPFO, BPFI, BSF, FTF).
+fn fault_orders(f: &FaultFrequencies) -> [f64; 4] {
+    let shaft = f.shaft.max(1e-12);
+    [f.bpfo / shaft, f.bpfi / shaft, f.bsf / shaft, f.ftf / shaft]
 }
 
 /// A model file's problem as the error naming it.
@@ -279,5 +290,65 @@ fn model_error(file: &str, e: FileError) -> ModelError {
             file: file.to_string(),
             why,
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::learned::features::OrderAxis;
+
+    fn card(bearing: &str, axis: OrderAxis) -> ModelCard {
+        ModelCard {
+            format: CARD_FORMAT,
+            classes: vec![SimulatedFault::None],
+            bearing: bearing.into(),
+            features: FeatureSettings {
+                axis,
+                ..FeatureSettings::default()
+            },
+            training: TrainingSummary {
+                dataset_spec: String::new(),
+                records: 0,
+                segments: 0,
+                epochs: 0,
+                seed: 0,
+                validation_accuracy: 0.0,
+            },
+        }
+    }
+
+    fn no_weights(name: &str, _: &[usize]) -> Result<Vec<f32>, FileError> {
+        Err(FileError::Malformed(format!("no tensor {name}")))
+    }
+
+    #[test]
+    fn a_shaft_order_model_whose_bearing_does_not_parse_is_refused_at_load() {
+        let err = LearnedModel::from_tensors(
+            card("no such bearing", OrderAxis::Shaft),
+            "m.safetensors".into(),
+            no_weights,
+        )
+        .unwrap_err();
+        let text = err.to_string();
+        assert!(
+            text.contains("m.safetensors") && text.contains("\"no such bearing\" does not parse"),
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_fault_relative_model_needs_no_single_bearing() {
+        // Its card names the bearings it was trained on; the load goes on to the weights.
+        let err = LearnedModel::from_tensors(
+            card(
+                "skf-6205-2rs, skf-6203-2rs",
+                OrderAxis::FaultRelative { harmonics: 5.0 },
+            ),
+            "m.safetensors".into(),
+            no_weights,
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("weights do not fit"), "{err}");
     }
 }

@@ -110,7 +110,7 @@ impl ModelSet {
         let shaft = |m: &&LearnedModel| m.card.features.axis.is_shaft();
         self.models
             .iter()
-            .find(|m| shaft(m) && m.knows_orders(freqs).unwrap_or(false))
+            .find(|m| shaft(m) && m.knows_orders(freqs))
             .or_else(|| self.models.iter().find(|m| !shaft(m)))
     }
 
