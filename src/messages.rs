@@ -224,6 +224,13 @@ pub struct RawBlock {
     pub counts: Vec<i32>,
 }
 
+impl RawBlock {
+    /// One past the block's last sample, in the channel's sample time.
+    pub fn end_sample(&self) -> u64 {
+        self.first_sample + self.counts.len() as u64
+    }
+}
+
 /// The averaged squared-envelope spectrum, at a low rate. Topic `/spectrum/<sensor>/<axis>`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct SpectrumMessage {

@@ -27,12 +27,11 @@ impl PipelineMessage {
     }
 
     /// Where the message stands in its channel's sample time: one past the last sample it
-    /// covers (`end_sample`; for a [`RawBlock`], which states its first sample and its counts,
-    /// `first_sample + counts.len()`). `None` for [`IngestMessage`]: a source's counters are
-    /// taken on the daemon's clock, not at a sample.
+    /// covers ([`RawBlock::end_sample`](super::RawBlock::end_sample) for a raw block). `None` for [`IngestMessage`]: a
+    /// source's counters are taken on the daemon's clock, not at a sample.
     pub fn end_sample(&self) -> Option<u64> {
         match self {
-            PipelineMessage::Raw(m) => Some(m.first_sample + m.counts.len() as u64),
+            PipelineMessage::Raw(m) => Some(m.end_sample()),
             PipelineMessage::Spectrum(m) => Some(m.end_sample),
             PipelineMessage::Indicators(m) => Some(m.end_sample),
             PipelineMessage::Twin(m) => Some(m.end_sample),

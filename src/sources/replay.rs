@@ -113,7 +113,7 @@ impl Iterator for ReplaySource {
                 }
                 continue;
             }
-            let end = block.first_sample + block.counts.len() as u64;
+            let end = block.end_sample();
             let fs = self
                 .rates
                 .get(&block.channel.sensor)
