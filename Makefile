@@ -18,6 +18,8 @@
 #   $(PREFIX)/lib/sysusers.d/bearingd.conf         the static system user and group `bearingd`
 #   $(PREFIX)/lib/tmpfiles.d/bearingd.conf         /dev/cpu_dma_latency writable by that group
 #   $(PREFIX)/share/doc/bearingd/SYSTEMD.md        the unit's Documentation=
+#   $(PREFIX)/share/bearingd/models/*.safetensors  the learned models, one per catalog bearing
+#                                                  (twin.learned_model; docs/PHYSICS.md)
 #   $(PREFIX)/share/man/man1/bearingd*.1           man pages of each program and command
 #                                                  (bearingd-lab*.1 not with install-service)
 #   $(PREFIX)/share/bash-completion/completions/bearingd, zsh/vendor-completions/_bearingd,
@@ -35,6 +37,7 @@ UNITDIR ?= $(PREFIX)/lib/systemd/system
 SYSUSERSDIR ?= $(PREFIX)/lib/sysusers.d
 TMPFILESDIR ?= $(PREFIX)/lib/tmpfiles.d
 DOCDIR ?= $(PREFIX)/share/doc/bearingd
+MODELDIR ?= $(PREFIX)/share/bearingd/models
 MANDIR ?= $(PREFIX)/share/man/man1
 BASHCOMPDIR ?= $(PREFIX)/share/bash-completion/completions
 ZSHCOMPDIR ?= $(PREFIX)/share/zsh/vendor-completions
@@ -64,6 +67,8 @@ endif
 # here) need no lab and run nothing they install.
 LAB_MANS := $(wildcard docs/cli/man/bearingd-lab.1 docs/cli/man/bearingd-lab-*.1)
 SERVICE_MANS := $(filter-out $(LAB_MANS),$(wildcard docs/cli/man/bearingd*.1))
+# The learned models the service may judge with (twin.learned_model), from the checkout.
+MODELS := $(wildcard models/*.safetensors)
 
 .PHONY: all build build-lab install install-service uninstall cli-docs
 
@@ -101,6 +106,8 @@ install-service: build
 	$(INSTALL) -D -m 0644 systemd/bearingd.sysusers "$(DESTDIR)$(SYSUSERSDIR)/bearingd.conf"
 	$(INSTALL) -D -m 0644 systemd/bearingd.tmpfiles "$(DESTDIR)$(TMPFILESDIR)/bearingd.conf"
 	$(INSTALL) -D -m 0644 docs/SYSTEMD.md "$(DESTDIR)$(DOCDIR)/SYSTEMD.md"
+	$(INSTALL) -d -m 0755 "$(DESTDIR)$(MODELDIR)"
+	$(INSTALL) -m 0644 $(MODELS) "$(DESTDIR)$(MODELDIR)/"
 	$(INSTALL) -d -m 0755 "$(DESTDIR)$(MANDIR)"
 	$(INSTALL) -m 0644 $(SERVICE_MANS) "$(DESTDIR)$(MANDIR)/"
 	$(INSTALL) -D -m 0644 docs/cli/completions/bearingd "$(DESTDIR)$(BASHCOMPDIR)/bearingd"
@@ -130,6 +137,8 @@ uninstall:
 	      "$(DESTDIR)$(DOCDIR)/SYSTEMD.md" \
 	      "$(DESTDIR)$(DOCDIR)/bearingd.toml.default"
 	rm -f "$(DESTDIR)$(MANDIR)"/bearingd.1 "$(DESTDIR)$(MANDIR)"/bearingd-*.1
+	rm -f $(addprefix "$(DESTDIR)$(MODELDIR)"/,$(notdir $(MODELS)))
+	rmdir "$(DESTDIR)$(MODELDIR)" "$(DESTDIR)$(dir $(MODELDIR))" 2>/dev/null || true
 	rm -f "$(DESTDIR)$(BASHCOMPDIR)/bearingd" "$(DESTDIR)$(BASHCOMPDIR)/bearingd-lab" \
 	      "$(DESTDIR)$(ZSHCOMPDIR)/_bearingd" "$(DESTDIR)$(ZSHCOMPDIR)/_bearingd-lab" \
 	      "$(DESTDIR)$(FISHCOMPDIR)/bearingd.fish" "$(DESTDIR)$(FISHCOMPDIR)/bearingd-lab.fish"

@@ -19,9 +19,12 @@
 #   mcap-sent  the MCAP file(s) of /var/log/bearingd were sent to the host over a second serial
 #              port (base64 between markers, with size and sha256)
 # and on the host:
-#   install    make install put every file in place, created no config over an existing one
-#   mcap       each file arrived intact; Python mcap's strict reader reads it with its summary
-#              and it holds the /flags/ message of the fault (tests/vm/check_vm_mcap.py)
+#   install    make install put every file in place (the learned models too), created no config
+#              over an existing one
+#   mcap       each file arrived intact; Python mcap's strict reader reads it with its summary,
+#              it holds the /flags/ message of the fault, and every twin fit the opinion of the
+#              installed 6205 model (the config names /usr/share/bearingd/models;
+#              tests/vm/check_vm_mcap.py)
 # Any FAIL or missing line fails the test. On failure the probe prints `systemctl status` and
 # the journal of bearingd to the serial log ($WORK/serial.log).
 #
@@ -85,7 +88,7 @@ for f in /usr/bin/bearingd /usr/lib/systemd/system/bearingd.service \
   /usr/lib/sysusers.d/bearingd.conf /usr/lib/tmpfiles.d/bearingd.conf /usr/share/doc/bearingd/SYSTEMD.md /etc/bearingd/bearingd.toml \
   /usr/share/man/man1/bearingd.1 /usr/share/man/man1/bearingd-run.1 \
   /usr/share/bash-completion/completions/bearingd /usr/share/zsh/vendor-completions/_bearingd \
-  /usr/share/fish/vendor_completions.d/bearingd.fish; do
+  /usr/share/fish/vendor_completions.d/bearingd.fish /usr/share/bearingd/models/skf-6205-2rs.safetensors; do
   check_installed "$f"
 done
 cmp -s "$ROOT/config/bearingd.toml" "$R/etc/bearingd/bearingd.toml" ||
@@ -117,6 +120,11 @@ onset_s = 2.0
 band_period_s = 5.0
 [thresholds]
 on_delay_s = 1.0
+[twin]
+# The installed models (make install), read by the service's user under the unit's sandbox;
+# every re-fit logs the 6205 model's opinion (check_vm_mcap.py).
+learned_model = "/usr/share/bearingd/models"
+refit_period_s = 3.0
 [outputs]
 status_interval_s = 2.0
 # Not 0: polling idle vCPUs would slow the emulated machine; the cap's path is what is tested.
@@ -127,7 +135,7 @@ install -m 0644 "$WORK/test.toml" "$R/etc/bearingd/bearingd.toml"
 make -s -C "$ROOT" install-service DESTDIR="$R" BIN="$WORK/bearingd" >> "$WORK/install.log"
 cmp -s "$WORK/test.toml" "$R/etc/bearingd/bearingd.toml" ||
   { install_ok=FAIL; install_detail+=" a second make install overwrote /etc/bearingd/bearingd.toml;"; }
-echo "VMTEST install: $install_ok ${install_detail:-binary, unit, sysusers.d, doc, man pages, completions, config in place; config kept on re-install; user $(cat "$WORK/passwd.line" 2>/dev/null)}" \
+echo "VMTEST install: $install_ok ${install_detail:-binary, unit, sysusers.d, doc, models, man pages, completions, config in place; config kept on re-install; user $(cat "$WORK/passwd.line" 2>/dev/null)}" \
   | tee "$WORK/host-verdicts.log"
 
 # The probe: a oneshot unit after bearingd that reports on ttyS0 and powers the VM off.
@@ -220,7 +228,9 @@ else
   # The flag is in one of the files (there is one unless the log rotated).
   grep -q '^flag message:' "$WORK"/mcap/*.check ||
     { mcap_ok=FAIL mcap_detail+=" no file holds the flag;"; }
-  [ "$mcap_ok" = FAIL ] || mcap_detail="$(ls "$WORK"/mcap/*.mcap | wc -l) file(s), $(tr '\n' ' ' < "$WORK/mcap-extract.log")strict reader: summary present, every message read, /flags/$SENSOR/... holds outer_race"
+  grep -q '^learned opinion:' "$WORK"/mcap/*.check ||
+    { mcap_ok=FAIL mcap_detail+=" no twin fit holds the installed model's opinion;"; }
+  [ "$mcap_ok" = FAIL ] || mcap_detail="$(ls "$WORK"/mcap/*.mcap | wc -l) file(s), $(tr '\n' ' ' < "$WORK/mcap-extract.log")strict reader: summary present, every message read, /flags/$SENSOR/... holds outer_race, every /twin fit the installed model's opinion"
 fi
 echo "VMTEST mcap: $mcap_ok $mcap_detail" | tee -a "$WORK/host-verdicts.log"
 
