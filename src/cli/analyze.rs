@@ -143,7 +143,12 @@ pub fn run(args: &AnalyzeArgs) -> Result<(), CliError> {
 /// record's outcome before it is printed.
 pub fn run_with(args: &AnalyzeArgs, on_record: &mut OnRecord) -> Result<(), CliError> {
     if args.hw {
-        return super::hw_table::run(&args.files, &args.recording, args.hw_states.into());
+        return super::hw_table::run(
+            &args.files,
+            &args.recording,
+            args.hw_states.into(),
+            args.format,
+        );
     }
     let config = match &args.config {
         Some(path) => Some(crate::config::load(path).map_err(CliError::input)?),

@@ -5,88 +5,114 @@
 //!
 //! The identification itself is sans-IO (`twin::hw`); the clock that times it lives here.
 
+use super::analyze::OutputFormat;
 use super::{CliError, RecordingArgs};
 use crate::recording::read_recording;
 use crate::twin::hw::{identify_record, HwConfig, StateFilter};
+use serde::Serialize;
 use std::collections::BTreeMap;
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// State orders of the seed's tables.
 const ORDERS: std::ops::RangeInclusive<usize> = 0..=9;
 
-/// One record: per order, (simulation accuracy %, one-step accuracy %, milliseconds,
-/// simulation accuracy from rest %).
-type RecordResult = Vec<(f64, f64, f64, f64)>;
+/// One identification: one record at one state order.
+#[derive(Debug, Clone, Copy, Serialize)]
+struct OrderResult {
+    order: usize,
+    /// 100·(1 − NRMSE) % of the simulation from the estimated initial state.
+    simulation_accuracy_pct: f64,
+    one_step_accuracy_pct: f64,
+    /// The simulation's accuracy from rest (zero initial state), for comparison.
+    simulation_accuracy_from_rest_pct: f64,
+    identification_ms: f64,
+}
 
+#[derive(Debug, Serialize)]
+struct RecordResult {
+    file: PathBuf,
+    /// The directory the record lies in (one bearing for FEMTO).
+    bearing: String,
+    orders: Vec<OrderResult>,
+}
+
+/// Per bearing, the means over its records.
+#[derive(Debug, Serialize)]
+struct BearingMeans {
+    bearing: String,
+    records: usize,
+    /// Per order: the mean simulation and one-step accuracies.
+    orders: Vec<OrderResult>,
+    /// Over every order.
+    simulation_accuracy_pct: f64,
+    simulation_accuracy_from_rest_pct: f64,
+    identification_ms: f64,
+}
+
+/// What `--format json` prints.
+#[derive(Debug, Serialize)]
+struct HwTable {
+    /// Where the median filter of the virtual states sits.
+    states: &'static str,
+    records: Vec<RecordResult>,
+    bearings: Vec<BearingMeans>,
+    /// The records that could not be identified, each with why.
+    failures: Vec<String>,
+}
+
+/// `--format text` and `table` print the Markdown tables; `json` one document with the same
+/// numbers. Progress goes to stderr: redrawn in place on a terminal, one line per record in a
+/// pipe.
 pub fn run(
     files: &[PathBuf],
     recording: &RecordingArgs,
     states: StateFilter,
+    format: OutputFormat,
 ) -> Result<(), CliError> {
-    let mut by_bearing: BTreeMap<String, Vec<RecordResult>> = BTreeMap::new();
-    let mut failures = 0;
-    println!(
-        "| record | {} |",
-        ORDERS
-            .map(|n| format!("n={n}"))
-            .collect::<Vec<_>>()
-            .join(" | ")
-    );
-    println!("|---|{}", "---|".repeat(ORDERS.count()));
+    let terminal = std::io::stderr().is_terminal();
+    let mut records = Vec::new();
+    let mut failures = Vec::new();
     for (done, file) in files.iter().enumerate() {
         match record(file, recording, states) {
-            Ok(result) => {
-                println!(
-                    "| {} | {} |",
-                    file.display(),
-                    result
-                        .iter()
-                        .map(|(sim, _, ms, _)| format!("{sim:.1} % {ms:.0} ms"))
-                        .collect::<Vec<_>>()
-                        .join(" | ")
-                );
-                by_bearing.entry(bearing_of(file)).or_default().push(result);
-            }
+            Ok(orders) => records.push(RecordResult {
+                file: file.clone(),
+                bearing: bearing_of(file),
+                orders,
+            }),
             Err(error) => {
-                failures += 1;
+                if terminal {
+                    eprintln!();
+                }
                 eprintln!("bearingd: error: {error}");
+                failures.push(error);
             }
         }
-        eprint!("\r{}/{} records", done + 1, files.len());
+        let line = format!("analyze --hw: {}/{} records", done + 1, files.len());
+        if terminal {
+            eprint!("\r{line}");
+        } else {
+            eprintln!("{line} ({})", file.display());
+        }
     }
-    eprintln!();
-    println!();
-    println!("Virtual states: median filter {}.", states.name());
-    println!();
-    println!("Mean per bearing (simulation accuracy 100·(1 − NRMSE) % from the estimated initial state, as MATLAB's compare; one-step in brackets; the mean from rest; mean identification time):");
-    println!();
-    println!(
-        "| bearing | records | {} | mean | mean from rest | ms per identification |",
-        ORDERS
-            .map(|n| format!("n={n}"))
-            .collect::<Vec<_>>()
-            .join(" | ")
-    );
-    println!("|---|---|{}---|---|---|", "---|".repeat(ORDERS.count()));
-    for (bearing, results) in &by_bearing {
-        let count = results.len() as f64;
-        let mean_of = |n: usize, pick: fn(&(f64, f64, f64, f64)) -> f64| {
-            results.iter().map(|r| pick(&r[n])).sum::<f64>() / count
-        };
-        let cells: Vec<String> = ORDERS
-            .map(|n| format!("{:.1} ({:.1})", mean_of(n, |r| r.0), mean_of(n, |r| r.1)))
-            .collect();
-        let overall = ORDERS.map(|n| mean_of(n, |r| r.0)).sum::<f64>() / ORDERS.count() as f64;
-        let from_rest = ORDERS.map(|n| mean_of(n, |r| r.3)).sum::<f64>() / ORDERS.count() as f64;
-        let ms = ORDERS.map(|n| mean_of(n, |r| r.2)).sum::<f64>() / ORDERS.count() as f64;
-        println!(
-            "| {bearing} | {} | {} | {overall:.1} | {from_rest:.1} | {ms:.0} |",
-            results.len(),
-            cells.join(" | ")
-        );
+    if terminal {
+        eprintln!();
     }
-    match failures {
+    let table = HwTable {
+        states: states.name(),
+        bearings: means_per_bearing(&records),
+        records,
+        failures,
+    };
+    match format {
+        OutputFormat::Json => println!(
+            "{}",
+            serde_json::to_string_pretty(&table).map_err(CliError::input)?
+        ),
+        OutputFormat::Text | OutputFormat::Table => print_markdown(&table),
+    }
+    match table.failures.len() {
         0 => Ok(()),
         n => Err(CliError::input(format!(
             "{n} of {} recordings could not be identified (see above)",
@@ -95,8 +121,108 @@ pub fn run(
     }
 }
 
+fn means_per_bearing(records: &[RecordResult]) -> Vec<BearingMeans> {
+    let mut by_bearing: BTreeMap<&str, Vec<&RecordResult>> = BTreeMap::new();
+    for r in records {
+        by_bearing.entry(&r.bearing).or_default().push(r);
+    }
+    by_bearing
+        .into_iter()
+        .map(|(bearing, results)| {
+            let count = results.len() as f64;
+            let orders: Vec<OrderResult> = ORDERS
+                .map(|n| {
+                    let mean = |pick: fn(&OrderResult) -> f64| {
+                        results.iter().map(|r| pick(&r.orders[n])).sum::<f64>() / count
+                    };
+                    OrderResult {
+                        order: n,
+                        simulation_accuracy_pct: mean(|o| o.simulation_accuracy_pct),
+                        one_step_accuracy_pct: mean(|o| o.one_step_accuracy_pct),
+                        simulation_accuracy_from_rest_pct: mean(|o| {
+                            o.simulation_accuracy_from_rest_pct
+                        }),
+                        identification_ms: mean(|o| o.identification_ms),
+                    }
+                })
+                .collect();
+            let over_orders = |pick: fn(&OrderResult) -> f64| {
+                orders.iter().map(pick).sum::<f64>() / orders.len() as f64
+            };
+            BearingMeans {
+                bearing: bearing.to_string(),
+                records: results.len(),
+                simulation_accuracy_pct: over_orders(|o| o.simulation_accuracy_pct),
+                simulation_accuracy_from_rest_pct: over_orders(|o| {
+                    o.simulation_accuracy_from_rest_pct
+                }),
+                identification_ms: over_orders(|o| o.identification_ms),
+                orders,
+            }
+        })
+        .collect()
+}
+
+/// The layout of the seed's Table A1: a row per record, then the means per bearing.
+fn print_markdown(table: &HwTable) {
+    let order_columns = ORDERS
+        .map(|n| format!("n={n}"))
+        .collect::<Vec<_>>()
+        .join(" | ");
+    println!("| record | {order_columns} |");
+    println!("|---|{}", "---|".repeat(ORDERS.count()));
+    for r in &table.records {
+        println!(
+            "| {} | {} |",
+            r.file.display(),
+            r.orders
+                .iter()
+                .map(|o| format!(
+                    "{:.1} % {:.0} ms",
+                    o.simulation_accuracy_pct, o.identification_ms
+                ))
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
+    }
+    println!();
+    println!("Virtual states: median filter {}.", table.states);
+    println!();
+    println!("Mean per bearing (simulation accuracy 100·(1 − NRMSE) % from the estimated initial state, as MATLAB's compare; one-step in brackets; the mean from rest; mean identification time):");
+    println!();
+    println!(
+        "| bearing | records | {order_columns} | mean | mean from rest | ms per identification |"
+    );
+    println!("|---|---|{}---|---|---|", "---|".repeat(ORDERS.count()));
+    for b in &table.bearings {
+        let cells: Vec<String> = b
+            .orders
+            .iter()
+            .map(|o| {
+                format!(
+                    "{:.1} ({:.1})",
+                    o.simulation_accuracy_pct, o.one_step_accuracy_pct
+                )
+            })
+            .collect();
+        println!(
+            "| {} | {} | {} | {:.1} | {:.1} | {:.0} |",
+            b.bearing,
+            b.records,
+            cells.join(" | "),
+            b.simulation_accuracy_pct,
+            b.simulation_accuracy_from_rest_pct,
+            b.identification_ms
+        );
+    }
+}
+
 /// Identifies every order on one record, timing each identification.
-fn record(file: &Path, args: &RecordingArgs, states: StateFilter) -> Result<RecordResult, String> {
+fn record(
+    file: &Path,
+    args: &RecordingArgs,
+    states: StateFilter,
+) -> Result<Vec<OrderResult>, String> {
     let recording = read_recording(file, &args.read_options()).map_err(|e| e.to_string())?;
     let fs_hz = args.fs.or(recording.fs_hz).ok_or_else(|| {
         format!(
@@ -114,12 +240,13 @@ fn record(file: &Path, args: &RecordingArgs, states: StateFilter) -> Result<Reco
             let fit = identify_record(&recording.samples, fs_hz, &config, None)
                 .map_err(|e| format!("{}: order {order}: {e}", file.display()))?;
             let ms = started.elapsed().as_secs_f64() * 1e3;
-            Ok((
-                fit.accuracy.simulation,
-                fit.accuracy.one_step,
-                ms,
-                fit.accuracy.simulation_zero_state,
-            ))
+            Ok(OrderResult {
+                order,
+                simulation_accuracy_pct: fit.accuracy.simulation,
+                one_step_accuracy_pct: fit.accuracy.one_step,
+                simulation_accuracy_from_rest_pct: fit.accuracy.simulation_zero_state,
+                identification_ms: ms,
+            })
         })
         .collect()
 }
