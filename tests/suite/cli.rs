@@ -389,3 +389,38 @@ fn completions_offer_every_command_of_the_service() {
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("tcsh") && err.contains("bash"), "{err}");
 }
+
+/// `analyze --hw` (the HW model of seed 003 at orders 0–9, the layout of its Table A1) honours
+/// `--format json`, and in a pipe its progress is one plain line per record.
+#[test]
+fn analyze_hw_prints_json_when_asked_and_plain_progress_in_a_pipe() {
+    let Some(femto) = shared_data_dir("femto") else {
+        return;
+    };
+    let snapshot = femto.join("Bearing1_2/acc_00001.csv");
+    let snapshot = snapshot.to_str().unwrap();
+    let out = bearingd(&["analyze", "--hw", "--format", "json", snapshot]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let table: serde_json::Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("not JSON ({e}): {}", String::from_utf8_lossy(&out.stdout)));
+    let orders = table["records"][0]["orders"].as_array().unwrap();
+    assert_eq!(orders.len(), 10, "{table:#}");
+    for (n, order) in orders.iter().enumerate() {
+        assert_eq!(order["order"], n);
+        let accuracy = order["simulation_accuracy_pct"].as_f64().unwrap();
+        assert!(accuracy > 50.0 && accuracy <= 100.0, "{order}");
+    }
+    assert_eq!(table["bearings"][0]["bearing"], "Bearing1_2");
+    assert_eq!(table["bearings"][0]["records"], 1);
+    assert_eq!(table["states"], "raw_once");
+    assert_eq!(table["failures"], serde_json::json!([]));
+    let progress = stderr(&out);
+    assert!(
+        progress.contains("analyze --hw: 1/1 records (") && !progress.contains('\r'),
+        "{progress:?}"
+    );
+
+    let text = bearingd(&["analyze", "--hw", snapshot]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(text.starts_with("| record | n=0 |"), "{text}");
+}
