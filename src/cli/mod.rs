@@ -38,7 +38,7 @@ pub struct RecordingArgs {
     /// Shaft speed in rpm (overrides what the file says).
     #[arg(long)]
     pub rpm: Option<f64>,
-    /// Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia,
+    /// Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt,
     /// rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0".
     #[arg(long)]
     pub bearing: Option<String>,

@@ -219,3 +219,50 @@ fn make_install_puts_pages_and_completions_under_destdir() {
         );
     }
 }
+
+/// Every `--bearing` option of both programs (any command, at any depth) and the help text it
+/// shows: its choices must be the ones an unknown name's error lists (the catalog).
+fn bearing_options(command: &clap::Command, path: &str, out: &mut Vec<(String, String)>) {
+    for arg in command.get_arguments() {
+        if arg.get_long() == Some("bearing") {
+            let help = arg.get_long_help().or(arg.get_help());
+            out.push((
+                path.to_string(),
+                help.map(|h| h.to_string()).unwrap_or_default(),
+            ));
+        }
+    }
+    for sub in command.get_subcommands() {
+        bearing_options(sub, &format!("{path} {}", sub.get_name()), out);
+    }
+}
+
+#[test]
+fn every_bearing_option_lists_the_catalog_its_error_lists() {
+    let mut options = Vec::new();
+    bearing_options(&bearingd::cli::command(), "bearingd", &mut options);
+    bearing_options(&bearingd_lab::cli::command(), "bearingd-lab", &mut options);
+    let commands: Vec<&str> = options.iter().map(|(path, _)| path.as_str()).collect();
+    for wanted in [
+        "bearingd analyze",
+        "bearingd import",
+        "bearingd-lab simulate",
+    ] {
+        assert!(
+            commands.contains(&wanted),
+            "no --bearing in {wanted}: {commands:?}"
+        );
+    }
+    let catalog = bearingd::bearing::BearingGeometry::catalog_names();
+    for (path, help) in &options {
+        let missing: Vec<_> = catalog
+            .iter()
+            .filter(|name| !help.contains(*name))
+            .collect();
+        assert!(
+            missing.is_empty(),
+            "{path} --bearing: its help leaves out {missing:?}, which an unknown name's error \
+             lists: {help}"
+        );
+    }
+}

@@ -44,7 +44,7 @@ inner\t''
 ball\t''
 cage\t''"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l rpm -d 'Shaft speed, rpm' -r
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l bearing -d 'Bearing: catalog name or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0"' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0"' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l duration -d 'Length of the record: seconds, e.g. 10 or 10s' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l fs -d 'Sample rate, Hz' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l out -d 'Output file: .csv (one column, g) or .wav (32-bit float, g)' -r -F
@@ -71,7 +71,7 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l n
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l spec -d 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l out -d 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/' -r -F
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l bearing -d 'Simulate this bearing instead of the spec\'s `bearing` (a catalog name or a custom geometry): one spec makes the training set of every bearing\'s model. The spec.toml written beside the set says the bearing used' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l bearing -d 'Simulate this bearing instead of the spec\'s `bearing`: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or a custom geometry. One spec makes the training set of every bearing\'s model; the spec.toml written beside the set says the bearing used' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l mcap -d 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -s h -l help -d 'Print help'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -l dataset -d 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes, and same bearing on shaft orders), e.g. a signal-model and a physics set' -r -F
@@ -85,7 +85,7 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l 
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l column -d 'Column of a CSV table: header name or 1-based index' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l fs -d 'Sample rate in Hz (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l rpm -d 'Shaft speed in rpm (overrides what the file says)' -r
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l fault -d 'The defect to model; default: the envelope diagnosis of the record' -r -f -a "none\t''
 outer\t''
 inner\t''
@@ -117,7 +117,7 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l chan
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l column -d 'Column of a CSV table: header name or 1-based index' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l fs -d 'Sample rate in Hz (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l rpm -d 'Shaft speed in rpm (overrides what the file says)' -r
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l format -d 'Output format' -r -f -a "text\t'The stage timeline and the trend, for people'
 json\t'Everything, per snapshot, as one JSON document'
 table\t'One Markdown table row per snapshot'"
@@ -135,7 +135,7 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l ch
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l column -d 'Column of a CSV table: header name or 1-based index' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l fs -d 'Sample rate in Hz (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l rpm -d 'Shaft speed in rpm (overrides what the file says)' -r
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l format -d 'Output format' -r -f -a "text\t'A few lines per record for people'
 json\t'One JSON document per record (a JSON array for several records)'
 table\t'One Markdown table row per record, for comparing many records'"

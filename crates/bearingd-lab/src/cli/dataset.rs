@@ -27,9 +27,10 @@ pub struct DatasetArgs {
     /// Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config.
     #[arg(long)]
     mcap: bool,
-    /// Simulate this bearing instead of the spec's `bearing` (a catalog name or a custom
-    /// geometry): one spec makes the training set of every bearing's model. The spec.toml
-    /// written beside the set says the bearing used.
+    /// Simulate this bearing instead of the spec's `bearing`: a catalog name (skf-6205-2rs,
+    /// skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or a custom geometry. One
+    /// spec makes the training set of every bearing's model; the spec.toml written beside the
+    /// set says the bearing used.
     #[arg(long)]
     bearing: Option<String>,
 }

@@ -32,7 +32,8 @@ pub struct SimulateArgs {
     /// Shaft speed, rpm.
     #[arg(long, default_value_t = 1772.0)]
     rpm: f64,
-    /// Bearing: catalog name or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0".
+    /// Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt,
+    /// rexnord-za-2115) or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0".
     #[arg(long, default_value = "skf-6205-2rs")]
     bearing: String,
     /// Length of the record: seconds, e.g. 10 or 10s.
