@@ -59,8 +59,8 @@ pub enum OfflineError {
         file: String,
         format: RecordingFormat,
     },
-    #[error("{file}: the shaft speed is unknown (the file does not state it); give it with --rpm, e.g. --rpm 1797")]
-    UnknownSpeed { file: String },
+    #[error("{file}: the shaft speed is unknown (the file does not state it); give it with --rpm RPM ({hint})")]
+    UnknownSpeed { file: String, hint: String },
     #[error("{file}: which bearing is it? give --bearing with a catalog name ({known}) or custom geometry \"z=8,d=5.97mm,D=31.62mm,alpha=0\"")]
     UnknownBearing { file: String, known: String },
     #[error("{what} {value} is not usable; {fix}")]
@@ -81,7 +81,10 @@ pub struct AnalyzeOutcome {
 /// What a data set's documentation says when the file itself does not.
 #[derive(Default)]
 struct DataSetFacts {
-    rpm: Option<f64>,
+    /// The constant shaft speed, and where it comes from.
+    rpm: Option<(f64, String)>,
+    /// Where the speed of a file of this kind can be found, for the error when it is unknown.
+    rpm_hint: Option<String>,
     /// The bearing, and why it is assumed.
     bearing: Option<(BearingGeometry, String)>,
 }
@@ -91,6 +94,26 @@ fn catalog(name: &str, why: &str) -> Option<(BearingGeometry, String)> {
     BearingGeometry::from_catalog(name)
         .ok()
         .map(|b| (b, format!("{name} ({why})")))
+}
+
+/// PRONOSTIA's operating conditions (the IEEE PHM 2012 challenge's): condition, shaft rpm.
+const PRONOSTIA_CONDITIONS: [(u32, f64); 3] = [(1, 1800.0), (2, 1650.0), (3, 1500.0)];
+
+/// The speed of a PRONOSTIA snapshot's operating condition, read from the directory its
+/// bearing's files lie in (`Bearing1_2/acc_00001.csv`: condition 1), as the data set names them.
+fn pronostia_condition_rpm(path: &std::path::Path) -> Option<(f64, String)> {
+    let dir = path.parent()?.file_name()?.to_str()?;
+    let condition: u32 = dir
+        .strip_prefix("Bearing")?
+        .split('_')
+        .next()?
+        .parse()
+        .ok()?;
+    let (_, rpm) = PRONOSTIA_CONDITIONS.iter().find(|(c, _)| *c == condition)?;
+    Some((
+        *rpm,
+        format!("PRONOSTIA's operating condition {condition} (the directory {dir})"),
+    ))
 }
 
 /// `X105_DE_time` and the like: a CWRU variable of the drive end, fan end or base.
@@ -105,6 +128,7 @@ fn data_set_facts(recording: &Recording) -> DataSetFacts {
     match recording.format {
         RecordingFormat::Matlab if is_cwru_channel(&recording.channel) => DataSetFacts {
             rpm: None,
+            rpm_hint: Some("a CWRU record states it in its XNNNRPM variable (1797 rpm at 0 hp, down to 1720 rpm at 3 hp)".into()),
             bearing: if recording.channel.contains("_FE_") {
                 catalog("skf-6203-2rs", "the CWRU fan-end bearing")
             } else {
@@ -114,18 +138,29 @@ fn data_set_facts(recording: &Recording) -> DataSetFacts {
         // The MFPT data set: struct `bearing` with the signal in `gs`.
         RecordingFormat::Matlab if recording.channel == "bearing.gs" => DataSetFacts {
             rpm: None,
+            rpm_hint: Some("an MFPT record states it in its `bearing.rate` field (shaft rate in Hz: 25 Hz is 1500 rpm)".into()),
             bearing: catalog("mfpt", "the MFPT data set's NICE bearing"),
         },
         RecordingFormat::PronostiaCsv => DataSetFacts {
-            rpm: None,
+            rpm: pronostia_condition_rpm(&recording.path),
+            rpm_hint: Some(format!(
+                "PRONOSTIA's speed is its operating condition's: {}",
+                PRONOSTIA_CONDITIONS
+                    .iter()
+                    .map(|(c, rpm)| format!("{rpm} rpm for Bearing{c}_N"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
             bearing: catalog("pronostia", "the PRONOSTIA test bearing"),
         },
         RecordingFormat::ImsText => DataSetFacts {
-            rpm: Some(2000.0),
+            rpm: Some((2000.0, "the IMS test rig's constant speed".into())),
+            rpm_hint: None,
             bearing: catalog("rexnord-za-2115", "the IMS test rig's bearing"),
         },
         RecordingFormat::McapLog => DataSetFacts {
             rpm: None,
+            rpm_hint: Some("a bearingd log states it in its /speed messages or its config's [sensors.speed]".into()),
             bearing: logged_bearing(&recording.path, &recording.channel)
                 .or_else(|| embedded_default_bearing(&recording.channel)),
         },
@@ -186,13 +221,17 @@ pub fn demo_recording() -> Recording {
 }
 
 /// What a recording was taken under, resolved from the caller's overrides, the file and the
-/// data set's documentation; every assumption is in `warnings`.
+/// data set's documentation.
 #[derive(Debug, Clone)]
 pub struct Conditions {
     pub fs_hz: f64,
     pub rpm: f64,
     pub rpm_source: SpeedSource,
     pub bearing: BearingGeometry,
+    /// What was assumed and why (a bearing or a speed from the data set's documentation, a
+    /// simulated record's settings): information, shown as `note:`.
+    pub notes: Vec<String>,
+    /// What is wrong with the file as read (the reader's own findings), shown as `warning:`.
     pub warnings: Vec<String>,
 }
 
@@ -206,6 +245,7 @@ pub fn resolve_conditions(
     let facts = if simulated {
         DataSetFacts {
             rpm: None,
+            rpm_hint: None,
             bearing: catalog("skf-6205-2rs", "the simulated bearing"),
         }
     } else {
@@ -228,12 +268,12 @@ pub fn resolve_conditions(
                 format: recording.format,
             })?,
     };
-    let (rpm, rpm_source) = match (request.rpm, recording.rpm, facts.rpm) {
+    let (rpm, rpm_source) = match (request.rpm, recording.rpm, &facts.rpm) {
         (Some(rpm), _, _) if !(rpm.is_finite() && rpm > 0.0) => {
             return Err(OfflineError::BadOverride {
                 what: "--rpm",
                 value: rpm,
-                fix: "give the shaft speed in rpm, e.g. --rpm 1797",
+                fix: "give the shaft speed in rpm, a positive number, e.g. --rpm 1500",
             })
         }
         (Some(rpm), _, _) => (rpm, SpeedSource::Given),
@@ -245,15 +285,27 @@ pub fn resolve_conditions(
                 SpeedSource::File
             },
         ),
-        (None, None, Some(rpm)) => (rpm, SpeedSource::DataSetDefault),
-        (None, None, None) => return Err(OfflineError::UnknownSpeed { file }),
+        (None, None, Some((rpm, _))) => (*rpm, SpeedSource::DataSetDefault),
+        (None, None, None) => {
+            return Err(OfflineError::UnknownSpeed {
+                file,
+                hint: facts
+                    .rpm_hint
+                    .unwrap_or_else(|| "the motor's nameplate or a tachometer gives it".into()),
+            })
+        }
     };
-    let mut warnings = recording.warnings.clone();
+    // A simulated record's "warnings" describe the simulation: they are notes.
+    let (mut notes, warnings) = if simulated {
+        (recording.warnings.clone(), Vec::new())
+    } else {
+        (Vec::new(), recording.warnings.clone())
+    };
     let bearing = match (&request.bearing, facts.bearing) {
         (Some(text), _) => BearingGeometry::parse(text)?,
         (None, Some((bearing, why))) => {
             if !simulated {
-                warnings.push(format!(
+                notes.push(format!(
                     "bearing not given: assumed {why}; give --bearing to change"
                 ));
             }
@@ -267,13 +319,17 @@ pub fn resolve_conditions(
         }
     };
     if rpm_source == SpeedSource::DataSetDefault {
-        warnings.push(format!("speed not in the file: assumed the data set's constant {rpm} rpm; give --rpm to change"));
+        let why = facts.rpm.map(|(_, why)| why).unwrap_or_default();
+        notes.push(format!(
+            "speed not in the file: assumed {rpm} rpm, {why}; give --rpm to change"
+        ));
     }
     Ok(Conditions {
         fs_hz,
         rpm,
         rpm_source,
         bearing,
+        notes,
         warnings,
     })
 }
@@ -306,6 +362,7 @@ pub fn analyze_recording(
         rpm,
         rpm_source,
         bearing,
+        notes,
         warnings,
     } = resolve_conditions(recording, request, simulated)?;
     let file = recording.path.display().to_string();
@@ -342,12 +399,13 @@ pub fn analyze_recording(
         rpm_source,
         bearing,
         selection: request.settings.band_selection,
+        notes,
         warnings,
     };
     let mut report = AnalyzeReport::new(&context, &analysis, &request.settings);
     // Velocity needs acceleration in physical units: a WAV file holds relative amplitudes.
     if recording.format == RecordingFormat::Wav && !simulated {
-        report.warnings.push(
+        report.notes.push(
             "no ISO 10816-3 velocity: a WAV file holds no scale to g; export the record in g (CSV, .mat) to get it".to_string(),
         );
     } else {

@@ -35,8 +35,11 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         ..Default::default()
     };
     let conditions = resolve_conditions(&recording, &request, false).map_err(CliError::input)?;
+    for note in &conditions.notes {
+        eprintln!("bearingd: import: note: {note}");
+    }
     for warning in &conditions.warnings {
-        eprintln!("bearingd: import: {warning}");
+        eprintln!("bearingd: import: warning: {warning}");
     }
     let fs = conditions.fs_hz;
     let imported = import_recording(&Import {

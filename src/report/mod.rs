@@ -44,6 +44,9 @@ pub struct RecordContext {
     pub rpm_source: SpeedSource,
     pub bearing: BearingGeometry,
     pub selection: BandSelection,
+    /// What was assumed (shown as `note:`).
+    pub notes: Vec<String>,
+    /// What is wrong with the record as read (shown as `warning:`).
     pub warnings: Vec<String>,
 }
 
@@ -164,6 +167,9 @@ pub struct AnalyzeReport {
     pub defect_size_mm: Option<DefectSizeReport>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub defect_size_note: Option<String>,
+    /// What the analysis assumed or could not do, and why: information, not a problem.
+    pub notes: Vec<String>,
+    /// What is wrong with the record as read (e.g. a truncated file read as far as valid).
     pub warnings: Vec<String>,
 }
 
@@ -465,6 +471,7 @@ impl AnalyzeReport {
             learned: None,
             defect_size_mm: None,
             defect_size_note: None,
+            notes: context.notes.clone(),
             warnings: context.warnings.clone(),
         };
         report.settle_plain();

@@ -150,6 +150,9 @@ pub fn render_text(r: &AnalyzeReport) -> String {
     for line in &r.detector_lines {
         let _ = writeln!(out, "  {line}");
     }
+    for note in &r.notes {
+        let _ = writeln!(out, "  note: {note}");
+    }
     for w in &r.warnings {
         let _ = writeln!(out, "  warning: {w}");
     }

@@ -236,9 +236,15 @@ fn issue16_a_2560_sample_snapshot_analyzes_with_default_options() {
     let snapshot = dir.join("acc_00001.csv");
     write_pronostia(&snapshot, &x);
 
-    // The file states its rate (25.6 kHz by its format) but not the speed.
+    // The file states its rate (25.6 kHz by its format) but not the speed, and its directory
+    // names no operating condition: the error says where PRONOSTIA's speeds come from.
     let err = analyze_error(&snapshot, &[]);
-    assert!(err.contains("--rpm"), "{err}");
+    assert!(
+        err.contains("--rpm RPM")
+            && err.contains("1800 rpm for Bearing1_N")
+            && !err.contains("1797"),
+        "{err}"
+    );
     let report = analyze_json(&snapshot, &["--rpm", "1800"]);
     assert_eq!(report["samples"], 2560);
     assert_eq!(report["fs_hz"], 25_600.0);
@@ -254,6 +260,27 @@ fn issue16_a_2560_sample_snapshot_analyzes_with_default_options() {
     let real = femto.join("Bearing1_2/acc_00001.csv");
     let report = analyze_json(&real, &["--rpm", "1800"]);
     assert_eq!(report["window_samples"], 2048);
+    // Without --rpm, the speed of the condition its directory names; what was assumed is a
+    // note, not a warning.
+    let report = analyze_json(&real, &[]);
+    assert_eq!(report["rpm"], 1800.0);
+    assert_eq!(report["rpm_source"], "data_set_default");
+    let notes = report["notes"].to_string();
+    assert!(
+        notes.contains(
+            "assumed 1800 rpm, PRONOSTIA's operating condition 1 (the directory Bearing1_2)"
+        ) && notes.contains("bearing not given: assumed pronostia"),
+        "{notes}"
+    );
+    assert_eq!(report["warnings"], serde_json::json!([]), "{report:#}");
+    let text = bearingd(&["analyze", real.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&text.stdout);
+    assert!(
+        text.contains("note: bearing not given") && !text.contains("warning:"),
+        "{text}"
+    );
+    let bearing3 = femto.join("Bearing3_1/acc_00001.csv");
+    assert_eq!(analyze_json(&bearing3, &[])["rpm"], 1500.0);
 }
 
 #[test]
@@ -262,7 +289,11 @@ fn issue16_a_wav_analyzes_given_the_speed_and_bearing_it_does_not_state() {
     let wav = dir.join("recorder.wav");
     simulate(&wav, "skf-6205-2rs", 1772.0, 12_000.0, 4.0);
     let err = analyze_error(&wav, &["--bearing", "skf-6205-2rs"]);
-    assert!(err.contains("--rpm"), "{err}");
+    // Not CWRU's speed: a WAV file's machine is anyone's.
+    assert!(
+        err.contains("--rpm RPM") && err.contains("nameplate") && !err.contains("1797"),
+        "{err}"
+    );
     let err = analyze_error(&wav, &["--rpm", "1772"]);
     assert!(err.contains("--bearing"), "{err}");
     let report = analyze_json(&wav, &["--rpm", "1772", "--bearing", "skf-6205-2rs"]);

@@ -123,7 +123,7 @@ fn issue16_a_wav_has_no_velocity_and_says_why() {
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(report["velocity"].is_null());
     assert!(
-        report["warnings"]
+        report["notes"]
             .to_string()
             .contains("no ISO 10816-3 velocity"),
         "{report:#}"

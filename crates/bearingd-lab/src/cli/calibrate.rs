@@ -100,8 +100,11 @@ pub fn run(args: &CalibrateArgs) -> Result<(), CliError> {
         ..AnalyzeRequest::default()
     };
     let conditions = resolve_conditions(&recording, &request, false).map_err(CliError::input)?;
+    for note in &conditions.notes {
+        eprintln!("bearingd: note: {note}");
+    }
     for warning in &conditions.warnings {
-        eprintln!("bearingd: note: {warning}");
+        eprintln!("bearingd: warning: {warning}");
     }
     let file = args.file.display().to_string();
     let samples: Vec<f32> = recording.samples.iter().map(|&x| x as f32).collect();

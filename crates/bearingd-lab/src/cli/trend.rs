@@ -129,6 +129,7 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         let (fs_hz, freqs) = match resolve_conditions(&recording, &request, false) {
             Ok(c) => {
                 // The recording's own warnings are among them.
+                notes.extend(c.notes);
                 notes.extend(c.warnings);
                 (c.fs_hz, Some(c.bearing.fault_frequencies(c.rpm / 60.0)))
             }
