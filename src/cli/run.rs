@@ -449,13 +449,16 @@ fn recovery_line(report: &RecoveryReport) -> String {
     }
 }
 
-/// One channel's status in one line.
+/// One channel's status in one line (its fields: docs/DAEMON.md "Status line").
 pub fn status_line(s: &ChannelStatus) -> String {
     let band = s.band_hz.map_or("learning".to_string(), |b| {
         format!("{:.0}-{:.0} Hz", b[0], b[1])
     });
+    // A window with no score (no band or no speed yet) has no top fault, whatever the order
+    // of four zeros would make the first.
     let top = s
         .top_fault
+        .filter(|_| s.top_score > 0.0)
         .map_or("-".to_string(), |f| format!("{f} {:.1}", s.top_score));
     let twin = match (&s.twin_hypothesis, s.twin_error) {
         (Some(h), Some(e)) => format!("{h} err {e:.3}"),
@@ -512,5 +515,51 @@ fn host_node_id() -> String {
         "bearingd".into()
     } else {
         id
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::messages::{ChannelId, FaultKind, FlagLevel, HealthStage};
+
+    fn status() -> ChannelStatus {
+        ChannelStatus {
+            channel: ChannelId {
+                sensor: "s1".into(),
+                axis: "radial".into(),
+            },
+            rpm: Some(1772.0),
+            speed_source: SpeedSource::Fixed,
+            samples: 25_600,
+            seconds: 1.0,
+            band_hz: Some([1067.0, 2133.0]),
+            top_fault: Some(FaultKind::Cage),
+            top_score: 0.0,
+            flags: [FlagLevel::Ok; 4],
+            stage: HealthStage::Learning,
+            gaps: 0,
+            missing_samples: 0,
+            twin_hypothesis: None,
+            twin_error: None,
+            sensor_lost: false,
+            flag_changes: 0,
+            readings: Vec::new(),
+            detector_flags: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn an_unscored_window_shows_no_top_fault() {
+        let line = status_line(&status());
+        assert!(line.contains(" top=- "), "{line}");
+        let scored = ChannelStatus {
+            top_fault: Some(FaultKind::OuterRace),
+            top_score: 12.34,
+            ..status()
+        };
+        let line = status_line(&scored);
+        assert!(line.contains(" top=outer_race 12.3 "), "{line}");
+        assert!(line.contains(" band=1067-2133 Hz "), "{line}");
     }
 }
