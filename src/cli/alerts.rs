@@ -76,7 +76,7 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
         printed: 0,
     };
 
-    let mut subscriber = open_when_available(&settings, &left)?;
+    let mut subscriber = open_when_available(&settings, &looked_for(args), &left)?;
     // The history: the alerts active when we subscribed.
     let mut active: BTreeMap<(String, String, u8), Alert> = BTreeMap::new();
     for received in subscriber
@@ -147,6 +147,7 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
 /// owner checks is exit 2 at once.
 fn open_when_available(
     settings: &AlertServiceSettings,
+    looked_for: &str,
     left: &impl Fn() -> Option<Duration>,
 ) -> Result<AlertSubscriber, CliError> {
     let uid = effective_uid();
@@ -167,10 +168,10 @@ fn open_when_available(
             }
             Err(e) => {
                 if left().is_some_and(|l| l.is_zero()) {
-                    return Err(CliError::failure(e));
+                    return Err(CliError::failure(format!("{e}; {looked_for}")));
                 }
                 if !said {
-                    eprintln!("bearingd alerts: waiting for the daemon: {e}");
+                    eprintln!("bearingd alerts: waiting for the daemon: {e}; {looked_for}");
                     said = true;
                 }
                 std::thread::sleep(
@@ -181,6 +182,32 @@ fn open_when_available(
             }
         }
     }
+}
+
+/// Which daemon the alert service was looked for, and how to point at another: a daemon
+/// without a config keeps its iceoryx2 root by its data directory, so one started from another
+/// directory is not found from here.
+fn looked_for(args: &AlertsArgs) -> String {
+    let whence = match (&args.config, &args.data_dir) {
+        (Some(config), _) => format!("the daemon of --config {}", config.display()),
+        (None, given) => {
+            let dir = given.clone().unwrap_or_else(|| "bearingd-data".into());
+            let absolute = std::path::absolute(&dir).unwrap_or(dir);
+            format!(
+                "the daemon of `bearingd run` without a config and with the data dir {}{}",
+                absolute.display(),
+                if given.is_none() {
+                    " (the default ./bearingd-data, from this directory)"
+                } else {
+                    ""
+                }
+            )
+        }
+    };
+    format!(
+        "looked for {whence}; for another, give its --data-dir DIR (as given to `bearingd run`) \
+         or its --config FILE (a service: --config /etc/bearingd/bearingd.toml)"
+    )
 }
 
 /// The owner of the iceoryx2 root (not following a link), if it can be looked at.

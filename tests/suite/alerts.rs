@@ -231,3 +231,36 @@ fn bearingd_alerts_prints_live_alerts_and_a_late_subscriber_gets_the_active_ones
         "{daemon_stdout}"
     );
 }
+
+/// With no daemon where it looks, `bearingd alerts` says which daemon it looked for (the data
+/// dir, made absolute, or the config) and how to point it at another.
+#[test]
+fn bearingd_alerts_without_a_daemon_names_where_it_looked_and_how_to_point_it() {
+    let dir = scratch_dir("alerts-nowhere");
+    let data = dir.join("no-daemon-here");
+    let out = bearingd()
+        .args(["alerts", "--timeout", "0", "--data-dir"])
+        .arg(&data)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains(&format!(
+            "looked for the daemon of `bearingd run` without a config and with the data dir {}",
+            data.display()
+        )) && err.contains("give its --data-dir DIR")
+            && err.contains("--config /etc/bearingd/bearingd.toml"),
+        "{err}"
+    );
+    let out = bearingd()
+        .current_dir(&dir)
+        .args(["alerts", "--timeout", "0"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("(the default ./bearingd-data, from this directory)"),
+        "{err}"
+    );
+}
