@@ -241,6 +241,36 @@ pub struct SpectrumMessage {
     pub windows_averaged: usize,
     /// Amplitude per bin from 0 Hz, g².
     pub amplitude: Vec<f32>,
+    /// The frequency of each bin of `amplitude`, Hz (`i × bin_hz`): the x axis a plot of the
+    /// spectrum needs (Foxglove's Plot panel plots `amplitude[:]` against `frequency_hz[:]`).
+    /// Absent in logs of older versions (read as empty).
+    #[serde(default)]
+    pub frequency_hz: Vec<f32>,
+}
+
+impl SpectrumMessage {
+    /// A spectrum message whose `frequency_hz` is filled from `bin_hz`, one per amplitude.
+    pub fn new(
+        channel: ChannelId,
+        end_sample: u64,
+        band_hz: [f64; 2],
+        bin_hz: f64,
+        windows_averaged: usize,
+        amplitude: Vec<f32>,
+    ) -> Self {
+        let frequency_hz = (0..amplitude.len())
+            .map(|i| (i as f64 * bin_hz) as f32)
+            .collect();
+        SpectrumMessage {
+            channel,
+            end_sample,
+            band_hz,
+            bin_hz,
+            windows_averaged,
+            amplitude,
+            frequency_hz,
+        }
+    }
 }
 
 /// Indicators and fault scores of the newest window. Topic `/indicators/<sensor>/<axis>`.
@@ -579,4 +609,24 @@ pub struct AlertMessage {
     /// The twin's fit error for this fault's hypothesis; `None` before the channel's first fit
     /// and where the twin has no hypothesis (cage, velocity zone).
     pub twin_error: Option<f64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_spectrum_has_a_frequency_per_bin_and_one_of_an_older_log_reads_without_them() {
+        let channel = ChannelId {
+            sensor: "motor-de".into(),
+            axis: "radial".into(),
+        };
+        let m = SpectrumMessage::new(channel, 10, [1.0, 2.0], 0.78125, 3, vec![1.0, 2.0, 3.0]);
+        assert_eq!(m.frequency_hz, [0.0, 0.78125, 1.5625]);
+        // A spectrum as versions before `frequency_hz` wrote it.
+        let old = r#"{"channel":{"sensor":"s","axis":"a"},"end_sample":5,"band_hz":[1.0,2.0],
+            "bin_hz":0.5,"windows_averaged":2,"amplitude":[1.0]}"#;
+        let read: SpectrumMessage = serde_json::from_str(old).unwrap();
+        assert_eq!((read.amplitude.len(), read.frequency_hz.len()), (1, 0));
+    }
 }

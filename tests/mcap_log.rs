@@ -495,14 +495,14 @@ fn bytes_per_day_of_one_25k6_channel() {
             let amplitude: Vec<f32> = spectrum_src.iter().rev().take(1024).copied().collect();
             logger
                 .log(
-                    &PipelineMessage::Spectrum(SpectrumMessage {
-                        channel: c.clone(),
-                        end_sample: end,
-                        band_hz: [2400.0, 3600.0],
-                        bin_hz: 0.78125,
-                        windows_averaged: 8,
+                    &PipelineMessage::Spectrum(SpectrumMessage::new(
+                        c.clone(),
+                        end,
+                        [2400.0, 3600.0],
+                        0.78125,
+                        8,
                         amplitude,
-                    }),
+                    )),
                     t,
                     t,
                 )

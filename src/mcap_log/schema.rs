@@ -449,14 +449,14 @@ mod tests {
     /// One message of every JSON kind, with a non-finite float where the kind has one.
     fn samples() -> Vec<PipelineMessage> {
         vec![
-            PipelineMessage::Spectrum(SpectrumMessage {
-                channel: channel(),
-                end_sample: 1,
-                band_hz: [500.0, 2500.0],
-                bin_hz: 0.5,
-                windows_averaged: 3,
-                amplitude: vec![1.0, f32::NAN],
-            }),
+            PipelineMessage::Spectrum(SpectrumMessage::new(
+                channel(),
+                1,
+                [500.0, 2500.0],
+                0.5,
+                3,
+                vec![1.0, f32::NAN],
+            )),
             PipelineMessage::Indicators(IndicatorsMessage {
                 channel: channel(),
                 end_sample: 1,

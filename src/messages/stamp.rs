@@ -79,14 +79,14 @@ mod tests {
                 1_003,
             ),
             (
-                PipelineMessage::Spectrum(SpectrumMessage {
-                    channel: channel("spectrum"),
-                    end_sample: 2_000,
-                    band_hz: [500.0, 2500.0],
-                    bin_hz: 0.5,
-                    windows_averaged: 3,
-                    amplitude: vec![1.0],
-                }),
+                PipelineMessage::Spectrum(SpectrumMessage::new(
+                    channel("spectrum"),
+                    2_000,
+                    [500.0, 2500.0],
+                    0.5,
+                    3,
+                    vec![1.0],
+                )),
                 "spectrum",
                 2_000,
             ),

@@ -615,17 +615,19 @@ fn handle_event(
             status.top_fault = Some(FaultKind::ALL[top]);
             status.top_score = w.scores[top].score;
             status.band_hz = Some([w.bands[top].lo_hz, w.bands[top].hi_hz]);
-            if w.end_sample >= *next_spectrum {
+            // A window before the bands are known has no spectrum yet: nothing to log, and the
+            // first spectrum is logged as soon as there is one (the schedule starts there).
+            if w.end_sample >= *next_spectrum && !w.spectrum.is_empty() {
                 *next_spectrum = w.end_sample + (spectrum_every_s * fs) as u64;
                 out(Output::Message(PipelineMessage::Spectrum(
-                    SpectrumMessage {
-                        channel: channel.clone(),
-                        end_sample: w.end_sample,
-                        band_hz: [w.spectrum_band.lo_hz, w.spectrum_band.hi_hz],
-                        bin_hz: w.bin_hz,
-                        windows_averaged: w.windows_averaged,
-                        amplitude: w.spectrum.to_vec(),
-                    },
+                    SpectrumMessage::new(
+                        channel.clone(),
+                        w.end_sample,
+                        [w.spectrum_band.lo_hz, w.spectrum_band.hi_hz],
+                        w.bin_hz,
+                        w.windows_averaged,
+                        w.spectrum.to_vec(),
+                    ),
                 )));
             }
             PipelineMessage::Indicators(IndicatorsMessage {

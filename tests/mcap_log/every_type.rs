@@ -26,14 +26,14 @@ pub(crate) fn every_type() -> Vec<PipelineMessage> {
             scale_g_per_count: 1.0 / 2048.0,
             counts: (-500..500).collect(),
         }),
-        PipelineMessage::Spectrum(SpectrumMessage {
-            channel: c.clone(),
-            end_sample: u64::MAX / 3,
-            band_hz: [2_000.0, 4_000.5],
-            bin_hz: 0.78125,
-            windows_averaged: 8,
-            amplitude: vec![0.1, 1e-7, 3.5, 0.0, 123_456.79],
-        }),
+        PipelineMessage::Spectrum(SpectrumMessage::new(
+            c.clone(),
+            u64::MAX / 3,
+            [2_000.0, 4_000.5],
+            0.78125,
+            8,
+            vec![0.1, 1e-7, 3.5, 0.0, 123_456.79],
+        )),
         PipelineMessage::Indicators(IndicatorsMessage {
             channel: c.clone(),
             end_sample: 25_600,

@@ -213,14 +213,14 @@ mod tests {
     }
 
     fn spectrum() -> PipelineMessage {
-        PipelineMessage::Spectrum(SpectrumMessage {
-            channel: channel(),
-            end_sample: 0,
-            band_hz: [500.0, 2500.0],
-            bin_hz: 1.0,
-            windows_averaged: 1,
-            amplitude: vec![1.0],
-        })
+        PipelineMessage::Spectrum(SpectrumMessage::new(
+            channel(),
+            0,
+            [500.0, 2500.0],
+            1.0,
+            1,
+            vec![1.0],
+        ))
     }
 
     #[test]
