@@ -13,6 +13,7 @@ mod envelope;
 #[cfg(feature = "tls")]
 mod fleet;
 mod formats;
+mod foxglove;
 mod hostile_alerts;
 mod hostile_files;
 mod hostile_logs;
