@@ -451,7 +451,9 @@ fn damaged_and_garbage_files_never_panic() {
 
 /// Bytes per day of one 25.6 kHz channel: 60 s of a simulated outer-race fault quantised to
 /// i16 at 0.000488 g/count in blocks of 1600 samples (1/16 s), plus a 1024-bin spectrum at
-/// 1 Hz, indicators at 6.4 Hz and a twin fit every 10 s. Printed for docs/MCAP.md.
+/// 1 Hz, indicators at 6.4 Hz and a twin fit every 10 s: a synthetic bound on the logger's
+/// compression. The figures docs/MCAP.md states are measured on a daemon's own log instead, and
+/// checked by the suite test `foxglove_layout_and_mcap_doc_match_a_daemon_log`.
 #[test]
 fn bytes_per_day_of_one_25k6_channel() {
     let dir = tempfile::tempdir().unwrap();
