@@ -7,11 +7,13 @@ A gateway, an HMI or a maintenance script can start from this. It mirrors the da
 
     pip install iceoryx2==0.10.0
     python3 examples/alerts_subscriber.py --root /run/bearingd/iceoryx2        # the service
-    python3 examples/alerts_subscriber.py --root $XDG_RUNTIME_DIR/bearingd-iox-...  # `bearingd run`
-                                        # without a config: the root it prints at start
+    python3 examples/alerts_subscriber.py --root ROOT   # `bearingd run` without a config: the
+        # root it prints at start ($XDG_RUNTIME_DIR/bearingd-iox-<hash of the data dir>, or
+        # /run/bearingd/iox-<hash> without a runtime directory)
 
-It prints the alerts active when it subscribes (the service keeps them in its history), then
-each alert as it comes, one JSON object per line. A gap in the sequence numbers means this
+It prints the alerts active when it subscribes (the service keeps them in its history; a
+cleared one is no longer active), with `"active_at_start": true`, then each alert as it comes
+(`false`), one JSON object per line: the lines of `bearingd alerts --json`. A gap in the sequence numbers means this
 subscriber fell behind and lost alerts: it says so. `--count N` exits 0 after N alerts,
 `--timeout S` exits 1 if they did not come in time.
 
@@ -87,7 +89,8 @@ class Alert(ctypes.Structure):
             "previous_severity": SEVERITIES.get(self.previous_severity, "unknown"),
             "confidence": self.confidence,
             "score": self.score,
-            "fault_frequency_hz": self.fault_frequency_hz,
+            # NaN (a detector's alert has no fault frequency) is null, as in `bearingd alerts`.
+            "fault_frequency_hz": self.fault_frequency_hz if self.fault_frequency_hz == self.fault_frequency_hz else None,
             "twin_error": twin if twin == twin else None,  # NaN: no twin fit yet
             "end_sample": self.end_sample,
             "sample_time_s": self.end_sample / self.sample_rate_hz if self.sample_rate_hz > 0 else None,
@@ -262,6 +265,26 @@ def main() -> int:
     history_until = time.monotonic() + 0.4  # the daemon hands its history within ~50 ms
     seen_any = False
     received = 0
+    # While the history comes: the alert active on each (sensor, axis, fault), as
+    # `bearingd alerts` keeps them; printed once the history is in.
+    active = {}
+    in_history = True
+    # An alert of a block completed after we subscribed came live while the history was read:
+    # printed as live after the active ones (a quick raise and clear is not folded away).
+    subscribed_ns = time.time_ns()
+    came_live = []
+
+    def emit(alert, active_at_start):
+        """Prints one alert as `bearingd alerts --json` does; True once --count is reached."""
+        nonlocal received
+        record = alert.to_dict()
+        record["type"] = "alert"
+        record["active_at_start"] = active_at_start
+        record["received_wall_ns"] = time.time_ns()
+        print(json.dumps(record), flush=True)
+        received += 1
+        return args.count is not None and received >= args.count
+
     while deadline is None or time.monotonic() < deadline:
         # Sleep until the daemon signals an alert (at most 200 ms, so the deadline is kept).
         listener.timed_wait(iox.Duration.from_millis(200))
@@ -280,14 +303,24 @@ def main() -> int:
         for kind, data in verdicts:
             if kind != "alert":
                 print(json.dumps({"type": kind, **data}), flush=True)
-                continue
-            record = data.to_dict()
-            record["type"] = "alert"
-            record["received_wall_ns"] = time.time_ns()
-            print(json.dumps(record), flush=True)
-            received += 1
-            if args.count is not None and received >= args.count:
+            elif in_history and data.wall_time_ns > subscribed_ns:
+                came_live.append(data)
+            elif in_history:
+                key = (bytes(data.sensor), bytes(data.axis), data.fault)
+                if STATES.get(data.state) == "cleared":
+                    active.pop(key, None)
+                else:
+                    active[key] = data
+            elif emit(data, False):
                 return 0
+        if in_history and time.monotonic() >= history_until:
+            in_history = False
+            for key in sorted(active):
+                if emit(active[key], True):
+                    return 0
+            for alert in came_live:
+                if emit(alert, False):
+                    return 0
     if args.count is not None:
         print(f"{received} of {args.count} alert(s) arrived within {args.timeout} s", file=sys.stderr)
         return 1

@@ -77,13 +77,20 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
     };
 
     let mut subscriber = open_when_available(&settings, &looked_for(args), &left)?;
-    // The history: the alerts active when we subscribed.
+    let subscribed_at_ns = wall_clock_now_ns();
+    // The history: the alerts active when we subscribed. An alert of a block completed after
+    // that came live while the history was read: it is printed as live, after the active ones
+    // (else a daemon quick to raise and clear would have both folded away unseen).
     let mut active: BTreeMap<(String, String, u8), Alert> = BTreeMap::new();
+    let mut came_live = Vec::new();
     for received in subscriber
         .take_history(HISTORY_WAIT)
         .map_err(CliError::input)?
     {
         match received {
+            Received::Alert(alert) if alert.wall_time_ns > subscribed_at_ns => {
+                came_live.push(alert);
+            }
             Received::Alert(alert) => {
                 let view = match alert.view() {
                     Ok(view) => view,
@@ -112,6 +119,12 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
     }
     for alert in active.values() {
         printer.alert(alert, true);
+        if printer.done(args.count) {
+            return Ok(());
+        }
+    }
+    for alert in &came_live {
+        printer.alert(alert, false);
         if printer.done(args.count) {
             return Ok(());
         }

@@ -206,6 +206,20 @@ fn bearingd_alerts_prints_live_alerts_and_a_late_subscriber_gets_the_active_ones
         .output()
         .unwrap();
     let late_text = String::from_utf8_lossy(&late.stdout).into_owned();
+    // The Python example, as late, prints what `bearingd alerts --json` printed.
+    let python_late = python_iceoryx2().map(|python| {
+        let root = bearingd::config::load(&config)
+            .unwrap()
+            .outputs
+            .iceoryx2_root;
+        Command::new(python)
+            .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/alerts_subscriber.py"))
+            .arg("--root")
+            .arg(root)
+            .args(["--count", "1", "--timeout", "20"])
+            .output()
+            .unwrap()
+    });
     let out = terminate(daemon);
     let daemon_stdout = String::from_utf8_lossy(&out.stdout);
     assert!(
@@ -219,6 +233,22 @@ fn bearingd_alerts_prints_live_alerts_and_a_late_subscriber_gets_the_active_ones
     assert_eq!(active[0]["fault"], "outer_race");
     assert_eq!(active[0]["run_id"], first[0]["run_id"]);
     assert!(active[0]["sequence"].as_u64() >= first[0]["sequence"].as_u64());
+    if let Some(python) = python_late {
+        let text = String::from_utf8_lossy(&python.stdout);
+        assert!(
+            python.status.success(),
+            "{text}\n{}",
+            String::from_utf8_lossy(&python.stderr)
+        );
+        let mut from_python = json_lines(&text);
+        assert_eq!(from_python.len(), 1, "{text}");
+        // Everything but the moment each subscriber received it.
+        let mut from_rust = active[0].clone();
+        for line in [&mut from_python[0], &mut from_rust] {
+            line.as_object_mut().unwrap().remove("received_wall_ns");
+        }
+        assert_eq!(from_python[0], from_rust);
+    }
 
     assert!(
         out.status.success(),
