@@ -8,11 +8,16 @@
 //! of sample rate are counted and reported, an unfinished file (a crash) is read as far as it
 //! is valid, with a warning.
 //!
-//! Coupling: only [`crate::mcap_log::read_messages`] and the message types; the log reader
-//! may move (the module "house"), this file should not need to.
+//! For a life over logs (`trend`), [`read_log`] also gives what the recording alone cannot:
+//! the log's wall-clock anchor (`log_time_origin_ns` of its `bearingd.run` record), the runs of
+//! contiguous samples (so that a gap is shown as one, not joined over), and the HW fits the
+//! daemon logged on `/hw/<sensor>/<axis>` (so that they are not identified again).
+//!
+//! Coupling: only [`crate::mcap_log::read_messages`], [`crate::mcap_log::read_header`] and the
+//! message types; the log reader may move (the module "house"), this file should not need to.
 
 use super::{Recording, RecordingError, RecordingFormat};
-use crate::mcap_log::{read_messages, LoggedMessage};
+use crate::mcap_log::{read_header, read_messages, LoggedMessage};
 use crate::messages::PipelineMessage;
 use std::collections::BTreeSet;
 use std::path::Path;
@@ -43,6 +48,40 @@ struct Joined {
     missing_samples: u64,
     overlaps: u64,
     rate_change: Option<(u64, f64)>,
+    /// Runs of contiguous samples, in the order they were kept.
+    segments: Vec<Segment>,
+}
+
+/// Samples `[offset, offset + len)` of the joined recording are the log's samples
+/// `[first_sample, first_sample + len)`, with no gap and no step back inside.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Segment {
+    pub offset: usize,
+    pub first_sample: u64,
+    pub len: usize,
+}
+
+/// One HW fit the daemon logged for the channel (`/hw/<sensor>/<axis>`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoggedHwFit {
+    /// One past the last sample of the fit's signal (the log's sample count).
+    pub end_sample: u64,
+    /// `100·(1 − NRMSE)` of its free run (%); `None` when the daemon could identify no model.
+    pub accuracy_simulation: Option<f64>,
+}
+
+/// What places a log's samples in time, beside its recording.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LogPlacement {
+    /// Wall-clock time of the log's sample 0, ns since the epoch (`log_time_origin_ns`);
+    /// `None` for a log without the `bearingd.run` record (an older bearingd).
+    pub origin_ns: Option<u64>,
+    /// The run's id: the same in every file of one run of the daemon.
+    pub run_id: Option<u64>,
+    /// The runs of contiguous samples of `recording.samples`, in order.
+    pub segments: Vec<Segment>,
+    /// The HW fits the daemon logged for this channel, in log order.
+    pub hw_fits: Vec<LoggedHwFit>,
 }
 
 impl Joined {
@@ -64,6 +103,14 @@ impl Joined {
         }
         let room = MAX_SAMPLES - self.samples.len();
         let take = counts.len().min(room);
+        match self.segments.last_mut() {
+            Some(last) if first_sample == self.next_sample => last.len += take,
+            _ => self.segments.push(Segment {
+                offset: self.samples.len(),
+                first_sample,
+                len: take,
+            }),
+        }
         self.samples
             .extend(counts[..take].iter().map(|&c| f64::from(c) * scale));
         self.dropped_samples += (counts.len() - take) as u64;
@@ -116,7 +163,16 @@ fn bad_log(path: &Path, e: &crate::mcap_log::McapLogError) -> RecordingError {
 }
 
 pub(super) fn read(path: &Path, selector: Option<&str>) -> Result<Recording, RecordingError> {
+    read_log(path, selector).map(|log| log.0)
+}
+
+/// Reads the log at `path` ([`read`]) with its anchor, runs of samples and logged HW fits.
+pub fn read_log(
+    path: &Path,
+    selector: Option<&str>,
+) -> Result<(Recording, LogPlacement), RecordingError> {
     let mut reader = read_messages(&[path]);
+    let mut hw_fits: Vec<(String, LoggedHwFit)> = Vec::new();
     let mut joined: Option<Joined> = None;
     let mut others = BTreeSet::new();
     let mut speeds: Vec<StatedSpeed> = Vec::new();
@@ -154,6 +210,7 @@ pub(super) fn read(path: &Path, selector: Option<&str>) -> Result<Recording, Rec
                     missing_samples: 0,
                     overlaps: 0,
                     rate_change: None,
+                    segments: Vec::new(),
                 });
                 j.push(
                     block.first_sample,
@@ -174,6 +231,14 @@ pub(super) fn read(path: &Path, selector: Option<&str>) -> Result<Recording, Rec
                 rpm: i.rpm,
                 source: "indicators".into(),
             }),
+            PipelineMessage::Hw(h) => hw_fits.push((
+                h.channel.to_string(),
+                LoggedHwFit {
+                    end_sample: h.end_sample,
+                    accuracy_simulation: (h.problem.is_none() && h.accuracy_simulation.is_finite())
+                        .then_some(h.accuracy_simulation),
+                },
+            )),
             _ => {}
         }
     }
@@ -255,7 +320,21 @@ pub(super) fn read(path: &Path, selector: Option<&str>) -> Result<Recording, Rec
     let end = j.first_sample + j.samples.len() as u64;
     let rpm = speed_of(&speeds, j.first_sample, end, &j.name, &mut warnings);
     let fs_hz = (j.fs_hz.is_finite() && j.fs_hz > 0.0).then_some(j.fs_hz);
-    Ok(Recording {
+    // The header is read again from the start: it stops at the first message, so it costs a
+    // chunk at most. A log without it (an older bearingd) has no anchor.
+    let header = read_header(path).ok();
+    let hw_fits = hw_fits
+        .into_iter()
+        .filter(|(channel, _)| *channel == j.name)
+        .map(|(_, fit)| fit)
+        .collect();
+    let placement = LogPlacement {
+        origin_ns: header.as_ref().and_then(|h| h.origin_ns),
+        run_id: header.as_ref().and_then(|h| h.run_id),
+        segments: j.segments,
+        hw_fits,
+    };
+    let recording = Recording {
         path: path.to_path_buf(),
         format: RecordingFormat::McapLog,
         channel: j.name,
@@ -263,7 +342,8 @@ pub(super) fn read(path: &Path, selector: Option<&str>) -> Result<Recording, Rec
         rpm,
         samples: j.samples,
         warnings,
-    })
+    };
+    Ok((recording, placement))
 }
 
 /// The speed over samples `[start, end)` of `channel`: the median of the speeds stated on its
