@@ -284,8 +284,10 @@ fn format_scientific(value: f64) -> String {
 
 /// Thins a series for drawing into `columns` pixel columns over `x_range`, keeping for each
 /// column its smallest and largest y in their original order, so a single-sample peak is
-/// never lost. Points with non-finite coordinates or outside `x_range` are skipped; extra
-/// values of the longer of `x`/`y` are ignored.
+/// never lost. A NaN y at a finite x inside `x_range` is a break (a gap, a missing value):
+/// it is kept as one `(x, NaN)` point so that the line stops there. Other points with
+/// non-finite coordinates or outside `x_range` are skipped; extra values of the longer of
+/// `x`/`y` are ignored.
 pub fn decimate_min_max(
     x: &[f64],
     y: &[f64],
@@ -324,6 +326,15 @@ pub fn decimate_min_max(
     let mut out = Vec::new();
     let mut bucket: Option<Bucket> = None;
     for (i, (&xv, &yv)) in x.iter().zip(y).enumerate() {
+        if yv.is_nan() && xv.is_finite() && xv >= x0 && xv <= x1 {
+            if let Some(b) = bucket.take() {
+                flush(&b, &mut out);
+            }
+            if out.last().is_some_and(|p| !p.1.is_nan()) {
+                out.push((xv, f64::NAN));
+            }
+            continue;
+        }
         if !(xv.is_finite() && yv.is_finite()) || xv < x0 || xv > x1 {
             continue;
         }
@@ -450,5 +461,16 @@ mod tests {
         assert!(decimate_min_max(&[], &[], (0.0, 1.0), 0).is_empty());
         let x: Vec<f64> = (0..10).map(f64::from).collect();
         assert!(decimate_min_max(&x, &x, (100.0, 200.0), 10).is_empty());
+    }
+
+    #[test]
+    fn a_nan_value_breaks_the_line_once() {
+        let x = [0.0, 1.0, 2.0, 3.0, 4.0, 5.0];
+        let y = [f64::NAN, 1.0, f64::NAN, f64::NAN, 5.0, 6.0];
+        let points = decimate_min_max(&x, &y, (0.0, 10.0), 100);
+        assert_eq!(points.len(), 4, "{points:?}");
+        assert_eq!(points[0], (1.0, 1.0));
+        assert!(points[1].0 == 2.0 && points[1].1.is_nan(), "{points:?}");
+        assert_eq!(&points[2..], [(4.0, 5.0), (5.0, 6.0)]);
     }
 }

@@ -54,6 +54,18 @@ fn stagger_labels(labels: Vec<(f64, String, Color)>) -> (Vec<PlacedLabel>, usize
     (placed, rows_used)
 }
 
+/// Can `label`'s leader run down to the plot without crossing a label in a row below it? If
+/// not it is left out: the label's colour and place still tie it to its marker line, and no
+/// line is drawn through another label's text.
+fn leader_is_clear(label: &PlacedLabel, all: &[PlacedLabel]) -> bool {
+    all.iter()
+        .filter(|other| other.row < label.row)
+        .all(|other| {
+            let right = other.x + text_width(&other.text, TEXT_SCALE);
+            label.marker_x < other.x - 1.0 || label.marker_x > right + 1.0
+        })
+}
+
 pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<Item>) {
     let plot_left = PLOT_LEFT;
     let plot_right = FIGURE_WIDTH - PLOT_RIGHT_PAD;
@@ -159,14 +171,16 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
     for label in &labels {
         let y = labels_top + (label_rows - 1 - label.row) as f64 * LINE_HEIGHT;
         let leader_x = crisp(label.marker_x);
-        items.push(Item::Polyline {
-            points: vec![(leader_x, y + GLYPH_SIZE + 2.0), (leader_x, area.top)],
-            stroke: Stroke {
-                color: label.color.with_alpha(label.color.a / 2),
-                width: 1.0,
-                dash: Some((1.0, 2.0)),
-            },
-        });
+        if leader_is_clear(label, &labels) {
+            items.push(Item::Polyline {
+                points: vec![(leader_x, y + GLYPH_SIZE + 2.0), (leader_x, area.top)],
+                stroke: Stroke {
+                    color: label.color.with_alpha(label.color.a / 2),
+                    width: 1.0,
+                    dash: Some((1.0, 2.0)),
+                },
+            });
+        }
         items.push(text(
             label.x,
             y,
@@ -177,24 +191,26 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
         ));
     }
 
-    // The series themselves.
+    // The series themselves, a line per run between breaks (NaN values).
     for (series, points) in panel.series.iter().zip(&thinned) {
-        let pixels: Vec<(f64, f64)> = points
-            .iter()
-            .filter_map(|&(x, y)| Some((x_scale.to_pixel(x)?, y_scale.to_pixel_clamped(y)?)))
-            .collect();
-        match pixels.as_slice() {
-            [] => {}
-            [(x, y)] => items.push(Item::Dot {
-                x: *x,
-                y: *y,
-                radius: 2.5,
-                color: series.color,
-            }),
-            _ => items.push(Item::Polyline {
-                points: pixels,
-                stroke: Stroke::solid(series.color, 1.25),
-            }),
+        for run in points.split(|p| p.1.is_nan()) {
+            let pixels: Vec<(f64, f64)> = run
+                .iter()
+                .filter_map(|&(x, y)| Some((x_scale.to_pixel(x)?, y_scale.to_pixel_clamped(y)?)))
+                .collect();
+            match pixels.as_slice() {
+                [] => {}
+                [(x, y)] => items.push(Item::Dot {
+                    x: *x,
+                    y: *y,
+                    radius: 2.5,
+                    color: series.color,
+                }),
+                _ => items.push(Item::Polyline {
+                    points: pixels,
+                    stroke: Stroke::solid(series.color, 1.25),
+                }),
+            }
         }
     }
 
@@ -257,6 +273,30 @@ mod tests {
         assert_eq!(rows, 2);
         let rows_by_label: Vec<_> = placed.iter().map(|p| (p.text.as_str(), p.row)).collect();
         assert_eq!(rows_by_label, [("BPFO", 0), ("2×BPFO", 0), ("BPFI", 1)]);
+    }
+
+    #[test]
+    fn no_leader_is_drawn_through_a_label_below_it() {
+        // "degrading" at 300 takes row 0; "failing" at 306 goes to row 1, and its leader
+        // would cross "degrading": it is left out. "healthy", far away, keeps its leader.
+        let (placed, rows) = stagger_labels(vec![
+            (100.0, "healthy".into(), Color::BLUE),
+            (300.0, "degrading".into(), Color::BLUE),
+            (306.0, "failing".into(), Color::BLUE),
+        ]);
+        assert_eq!(rows, 2);
+        let clear: Vec<_> = placed
+            .iter()
+            .map(|p| (p.text.as_str(), p.row, leader_is_clear(p, &placed)))
+            .collect();
+        assert_eq!(
+            clear,
+            [
+                ("healthy", 0, true),
+                ("degrading", 0, true),
+                ("failing", 1, false)
+            ]
+        );
     }
 
     #[test]
