@@ -2,7 +2,7 @@
 //! document, the text summary and the figure (stage timeline with RMS, kurtosis, HW residual and
 //! fault score, and the RMS trend with its band), so they always agree.
 
-use crate::life::{LifePoint, StageEvent, TrendHindsight};
+use crate::life::{HwFrom, LifePoint, StageEvent, TrendHindsight};
 use crate::messages::HealthStage;
 use crate::plot::{Color, Figure, Marker, Series, Shade, SpectrumPanel};
 use serde::Serialize;
@@ -27,6 +27,18 @@ pub struct SkippedFile {
     pub error: String,
 }
 
+/// A stretch of time without samples between two snapshots of logs (between runs, or
+/// samples lost): the plot's lines break there.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LifeGap {
+    /// The snapshot before the gap and the one after it.
+    pub after: String,
+    pub before: String,
+    /// Life time (s) of the last sample before the gap and of the first after it.
+    pub from_s: f64,
+    pub to_s: f64,
+}
+
 /// A bearing's life as `trend` saw it.
 #[derive(Debug, Clone, Serialize)]
 pub struct LifeReport {
@@ -36,6 +48,8 @@ pub struct LifeReport {
     /// Stage changes in order.
     pub events: Vec<StageEvent>,
     pub points: Vec<LifePoint>,
+    /// Stretches without samples, in time order (logs only).
+    pub gaps: Vec<LifeGap>,
     /// The RMS trend's estimates judged against the crossing they predicted.
     pub hindsight: Option<TrendHindsight>,
     /// Files that looked like snapshots but could not be used.
@@ -121,9 +135,19 @@ pub fn render_life_text(report: &LifeReport) -> String {
         );
     }
     if let Some(last) = report.points.last() {
-        let hw = last
-            .hw_residual_percent
-            .map_or("n/a".into(), |r| format!("{r:.1} %"));
+        // A daemon log has a fit every re-fit: the newest one when the last snapshot has none.
+        let hw = match (
+            last.hw_residual_percent,
+            report
+                .points
+                .iter()
+                .rev()
+                .find_map(|p| p.hw_residual_percent.map(|r| (r, p.time_s))),
+        ) {
+            (Some(r), _) => format!("{r:.1} %"),
+            (None, Some((r, t))) => format!("{r:.1} % (the newest fit, at {})", duration_text(t)),
+            (None, None) => "n/a".into(),
+        };
         let score = match (last.fault_score, last.fault) {
             (Some(s), Some(f)) => format!("{s:.1} ({})", f.name()),
             _ => "n/a".into(),
@@ -139,6 +163,17 @@ pub fn render_life_text(report: &LifeReport) -> String {
     }
     if let Some(h) = &report.hindsight {
         let _ = writeln!(out, "  {}", hindsight_text(h));
+    }
+    for gap in &report.gaps {
+        let _ = writeln!(
+            out,
+            "  gap: no samples from {} to {} ({}), between {} and {}",
+            duration_text(gap.from_s),
+            duration_text(gap.to_s),
+            duration_text(gap.to_s - gap.from_s),
+            gap.after,
+            gap.before
+        );
     }
     for note in &report.notes {
         let _ = writeln!(out, "  note: {note}");
@@ -251,18 +286,81 @@ fn stage_color(stage: HealthStage) -> Option<Color> {
     }
 }
 
-/// The figure: four panels over life time (hours), stages shaded, stage changes marked.
+/// Said on the figure when the fault score never leaves its floor.
+const FLAT_SCORE_NOTE: &str = "fault score 1.0 on every snapshot: no fault line stands above the noise floor of these snapshots (docs/HEALTH.md says why)";
+
+/// The life time axis: seconds per unit and the unit's name, chosen by the life's span.
+fn time_unit(span_s: f64) -> (f64, &'static str) {
+    if span_s >= 2.0 * 3600.0 {
+        (3600.0, "h")
+    } else if span_s >= 120.0 {
+        (60.0, "min")
+    } else {
+        (1.0, "s")
+    }
+}
+
+/// The places along a panel's x axis: a snapshot (its index) or a break (`None`, at a time
+/// in s) where the lines stop, in the middle of each gap.
+#[derive(Clone)]
+struct Slots(Vec<(Option<usize>, f64)>);
+
+impl Slots {
+    /// Every snapshot, with a break in each gap.
+    fn of(report: &LifeReport) -> Slots {
+        let mut gaps = report.gaps.iter().peekable();
+        let mut slots = Vec::new();
+        for (i, p) in report.points.iter().enumerate() {
+            while let Some(g) = gaps.next_if(|g| g.to_s <= p.time_s) {
+                slots.push((None, 0.5 * (g.from_s + g.to_s)));
+            }
+            slots.push((Some(i), p.time_s));
+        }
+        Slots(slots)
+    }
+
+    /// Only the snapshots `keep` accepts (and the breaks).
+    fn only(&self, keep: impl Fn(usize) -> bool) -> Slots {
+        Slots(
+            self.0
+                .iter()
+                .copied()
+                .filter(|(i, _)| i.is_none_or(&keep))
+                .collect(),
+        )
+    }
+
+    fn x(&self, unit_s: f64) -> Vec<f64> {
+        self.0.iter().map(|(_, t)| t / unit_s).collect()
+    }
+
+    /// `values` (one per snapshot) along the slots, NaN at the breaks.
+    fn y(&self, values: &[f64]) -> Vec<f64> {
+        self.0
+            .iter()
+            .map(|(i, _)| i.and_then(|i| values.get(i).copied()).unwrap_or(f64::NAN))
+            .collect()
+    }
+}
+
+/// The figure: panels over life time, stages shaded, stage changes marked, lines broken at
+/// the gaps; a panel only when it has something to show (no HW residual with `--no-hw`, no
+/// fault score without a speed).
 pub fn life_figure(report: &LifeReport) -> Figure {
-    let hours: Vec<f64> = report.points.iter().map(|p| p.time_s / 3600.0).collect();
-    let end_h = hours.last().copied().unwrap_or(0.0);
-    // Stage shading: from each change to the next (learning from the start).
+    let (unit_s, unit) = time_unit(report.span_s());
+    let x_label = format!("life time ({unit})");
+    let slots = Slots::of(report);
+    let x = slots.x(unit_s);
+    let end_x = x.last().copied().unwrap_or(0.0);
+    // Stage shading: from each change to the next (learning from the start); the last to
+    // beyond the end (clipped to the plot), so that it covers a trend drawn past the end.
     let mut spans: Vec<(HealthStage, f64)> = vec![(HealthStage::Learning, 0.0)];
-    spans.extend(report.events.iter().map(|e| (e.to, e.time_s / 3600.0)));
+    spans.extend(report.events.iter().map(|e| (e.to, e.time_s / unit_s)));
     let shades: Vec<Shade> = spans
         .iter()
         .enumerate()
         .filter_map(|(i, &(stage, from))| {
-            let to = spans.get(i + 1).map_or(end_h, |s| s.1);
+            let to = spans.get(i + 1).map_or(4.0 * end_x + 1.0, |s| s.1);
             stage_color(stage).map(|color| Shade {
                 x0: from,
                 x1: to,
@@ -274,7 +372,7 @@ pub fn life_figure(report: &LifeReport) -> Figure {
         .events
         .iter()
         .map(|e| Marker {
-            x: e.time_s / 3600.0,
+            x: e.time_s / unit_s,
             label: e.to.name().into(),
             color: match e.to {
                 HealthStage::Failing => Color::VERMILLION,
@@ -284,41 +382,47 @@ pub fn life_figure(report: &LifeReport) -> Figure {
             dashed: true,
         })
         .collect();
-    let dress = |mut panel: SpectrumPanel| {
+    let panel = |y_label: &str, x: Vec<f64>| {
+        let mut panel = SpectrumPanel::new(x_label.clone(), y_label, x);
         panel.shaded = shades.clone();
         panel.markers = markers.clone();
         panel
     };
-    let pick = |f: &dyn Fn(&LifePoint) -> Option<f64>| -> Vec<f64> {
+    let values = |f: &dyn Fn(&LifePoint) -> Option<f64>| -> Vec<f64> {
         report
             .points
             .iter()
             .map(|p| f(p).unwrap_or(f64::NAN))
             .collect()
     };
+    let pick = |f: &dyn Fn(&LifePoint) -> Option<f64>| slots.y(&values(f));
 
     // RMS, with the newest trend and its band carried forward to its crossing or horizon.
     let trend = report.points.iter().rev().find_map(|p| p.trend);
-    let mut rms_x = hours.clone();
+    let mut rms_x = x.clone();
     let mut rms = pick(&|p| Some(p.rms));
     let mut tracked = pick(&|p| Some(p.rms_tracked));
     let mut limit = pick(&|p| p.rms_limit);
-    let (mut fit, mut lo, mut hi) = (vec![f64::NAN; rms_x.len()], rms.clone(), rms.clone());
-    lo.fill(f64::NAN);
-    hi.fill(f64::NAN);
+    let (mut fit, mut lo, mut hi) = (
+        vec![f64::NAN; report.points.len()],
+        vec![f64::NAN; report.points.len()],
+        vec![f64::NAN; report.points.len()],
+    );
     if let Some(t) = trend {
         let window = report.settings.trend_window.min(report.points.len());
         let first = report.points.len() - window;
         for i in first..report.points.len() {
-            let (f, l, h) = t.band_at(report.points[i].time_s);
-            (fit[i], lo[i], hi[i]) = (f, l, h);
+            (fit[i], lo[i], hi[i]) = t.band_at(report.points[i].time_s);
         }
+    }
+    let (mut fit, mut lo, mut hi) = (slots.y(&fit), slots.y(&lo), slots.y(&hi));
+    if let Some(t) = trend {
         let until = t.latest_s.or(t.crossing_s).unwrap_or(t.horizon_s);
         let steps = 40;
         for k in 1..=steps {
             let time = t.now_s + (until - t.now_s) * f64::from(k) / f64::from(steps);
             let (f, l, h) = t.band_at(time);
-            rms_x.push(time / 3600.0);
+            rms_x.push(time / unit_s);
             for (v, x) in [
                 (&mut fit, f),
                 (&mut lo, l),
@@ -331,7 +435,7 @@ pub fn life_figure(report: &LifeReport) -> Figure {
             limit.push(t.threshold);
         }
     }
-    let mut rms_panel = dress(SpectrumPanel::new("life time (h)", "RMS (g)", rms_x));
+    let mut rms_panel = panel("RMS (g)", rms_x);
     rms_panel.log_y = true;
     rms_panel.series = vec![
         Series {
@@ -371,11 +475,7 @@ pub fn life_figure(report: &LifeReport) -> Figure {
         ]);
     }
 
-    let mut kurtosis = dress(SpectrumPanel::new(
-        "life time (h)",
-        "kurtosis",
-        hours.clone(),
-    ));
+    let mut kurtosis = panel("kurtosis", x.clone());
     kurtosis.log_y = true;
     kurtosis.series = vec![
         Series {
@@ -394,29 +494,9 @@ pub fn life_figure(report: &LifeReport) -> Figure {
             color: Color::ORANGE,
         },
     ];
-    let mut hw = dress(SpectrumPanel::new(
-        "life time (h)",
-        "HW residual (% NRMSE)",
-        hours.clone(),
-    ));
-    hw.series = vec![Series {
-        label: "HW free-run residual, order 0".into(),
-        y: pick(&|p| p.hw_residual_percent),
-        color: Color::BLUISH_GREEN,
-    }];
-    let mut score = dress(SpectrumPanel::new(
-        "life time (h)",
-        "envelope fault score",
-        hours,
-    ));
-    score.series = vec![Series {
-        label: "strongest fault score".into(),
-        y: pick(&|p| p.fault_score),
-        color: Color::REDDISH_PURPLE,
-    }];
 
     let mut figure = Figure::new(format!("Life of {} [{}]", report.path, report.channel));
-    let time_left = time_left_panel(report, &shades, &markers);
+    let time_left = time_left_panel(report, &slots, (unit_s, &x_label), &shades, &markers);
     let stages: Vec<String> = report
         .events
         .iter()
@@ -429,8 +509,12 @@ pub fn life_figure(report: &LifeReport) -> Figure {
         })
         .collect();
     figure = figure.with_note(format!(
-        "{} snapshots; stages: {}",
+        "{} snapshots{}; stages: {}",
         report.points.len(),
+        match report.gaps.len() {
+            0 => String::new(),
+            n => format!(", {n} gap(s) (lines break there)"),
+        },
         if stages.is_empty() {
             "none".into()
         } else {
@@ -444,20 +528,60 @@ pub fn life_figure(report: &LifeReport) -> Figure {
     if let Some(panel) = time_left {
         figure = figure.with_panel(panel);
     }
-    figure.with_panel(kurtosis).with_panel(hw).with_panel(score)
+    figure = figure.with_panel(kurtosis);
+
+    // The HW residual over the snapshots that have one (a daemon log has one per re-fit).
+    let hw_values = values(&|p| p.hw_residual_percent);
+    if hw_values.iter().any(|v| v.is_finite()) {
+        let hw_slots = slots.only(|i| hw_values[i].is_finite());
+        let logged = report.points.iter().any(|p| p.hw_from == Some(HwFrom::Log));
+        let mut hw = panel("HW residual (% NRMSE)", hw_slots.x(unit_s));
+        // The same time axis as the other panels, though the fits may be sparse.
+        hw.x_range = Some((x.first().copied().unwrap_or(0.0), end_x));
+        hw.series = vec![Series {
+            label: if logged {
+                "HW residual, order 0 (daemon's fits)".into()
+            } else {
+                "HW free-run residual, order 0".into()
+            },
+            y: hw_slots.y(&hw_values),
+            color: Color::BLUISH_GREEN,
+        }];
+        figure = figure.with_panel(hw);
+    }
+    let scores = values(&|p| p.fault_score);
+    if scores.iter().any(|v| v.is_finite()) {
+        let floor = scores.iter().filter(|v| v.is_finite()).all(|&v| v <= 1.0);
+        if floor {
+            figure = figure.with_note(FLAT_SCORE_NOTE);
+        }
+        let mut score = panel("envelope fault score", x);
+        score.series = vec![Series {
+            label: if floor {
+                "strongest fault score (1.0: the floor)".into()
+            } else {
+                "strongest fault score".into()
+            },
+            y: slots.y(&scores),
+            color: Color::REDDISH_PURPLE,
+        }];
+        figure = figure.with_panel(score);
+    }
+    figure
 }
 
 /// Each snapshot's predicted time to the threshold with its band, and (in hindsight) the time
 /// that was really left; `None` when no snapshot had a trend.
 fn time_left_panel(
     report: &LifeReport,
+    slots: &Slots,
+    (unit_s, x_label): (f64, &str),
     shades: &[Shade],
     markers: &[Marker],
 ) -> Option<SpectrumPanel> {
     report.points.iter().find(|p| p.trend.is_some())?;
-    let hours: Vec<f64> = report.points.iter().map(|p| p.time_s / 3600.0).collect();
     let minutes = |f: &dyn Fn(&crate::analysis::degradation::TrendFit) -> Option<f64>| {
-        report
+        let per_point: Vec<f64> = report
             .points
             .iter()
             .map(|p| {
@@ -465,9 +589,10 @@ fn time_left_panel(
                     .and_then(|t| f(&t).map(|at| (at - t.now_s) / 60.0))
                     .unwrap_or(f64::NAN)
             })
-            .collect::<Vec<f64>>()
+            .collect();
+        slots.y(&per_point)
     };
-    let mut panel = SpectrumPanel::new("life time (h)", "time to threshold (min)", hours);
+    let mut panel = SpectrumPanel::new(x_label, "time to threshold (min)", slots.x(unit_s));
     panel.shaded = shades.to_vec();
     panel.markers = markers.to_vec();
     panel.series = vec![
@@ -490,16 +615,123 @@ fn time_left_panel(
     if let Some(h) = &report.hindsight {
         panel.series.push(Series {
             label: "really left (hindsight)".into(),
-            y: report
+            y: slots.y(&report
                 .points
                 .iter()
                 .map(|p| match p.trend {
                     Some(_) if p.time_s <= h.crossed_s => (h.crossed_s - p.time_s) / 60.0,
                     _ => f64::NAN,
                 })
-                .collect(),
+                .collect::<Vec<f64>>()),
             color: Color::BLACK,
         });
     }
     Some(panel)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plot::Panel;
+
+    fn point(i: usize, time_s: f64, hw: Option<f64>, score: Option<f64>) -> LifePoint {
+        LifePoint {
+            source: format!("s{i}"),
+            time_s,
+            rms: 0.1,
+            kurtosis: 3.0,
+            rms_tracked: 0.1,
+            kurtosis_tracked: 3.0,
+            hw_residual_percent: hw,
+            hw_from: hw.map(|_| HwFrom::Log),
+            fault_score: score,
+            fault: None,
+            stage: HealthStage::Learning,
+            kurtosis_limit: None,
+            rms_limit: None,
+            trend: None,
+        }
+    }
+
+    fn report(points: Vec<LifePoint>, gaps: Vec<LifeGap>) -> LifeReport {
+        LifeReport {
+            path: "logs".into(),
+            channel: "s/x".into(),
+            settings: LifeSettingsReport {
+                baseline_snapshots: 15,
+                sigma: 3.0,
+                confirm_snapshots: 3,
+                smoothing: 3,
+                trend_window: 12,
+                confidence: 0.9,
+                threshold_rms: None,
+            },
+            events: Vec::new(),
+            points,
+            gaps,
+            hindsight: None,
+            skipped: Vec::new(),
+            ignored: Vec::new(),
+            notes: Vec::new(),
+        }
+    }
+
+    fn y_labels(figure: &Figure) -> Vec<String> {
+        figure
+            .panels
+            .iter()
+            .filter_map(|p| match p {
+                Panel::Spectrum(s) => Some(s.y_label.clone()),
+                Panel::Heatmap(_) => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_panel_is_drawn_only_when_it_has_something_to_show() {
+        let bare = report(
+            (0..5).map(|i| point(i, i as f64, None, None)).collect(),
+            vec![],
+        );
+        assert_eq!(y_labels(&life_figure(&bare)), ["RMS (g)", "kurtosis"]);
+        let full = report(
+            (0..5)
+                .map(|i| point(i, i as f64, (i == 2).then_some(12.0), Some(2.0)))
+                .collect(),
+            vec![],
+        );
+        assert_eq!(
+            y_labels(&life_figure(&full)),
+            [
+                "RMS (g)",
+                "kurtosis",
+                "HW residual (% NRMSE)",
+                "envelope fault score"
+            ]
+        );
+    }
+
+    #[test]
+    fn the_lines_break_in_a_gap() {
+        let points = vec![
+            point(0, 0.0, None, None),
+            point(1, 1.0, None, None),
+            point(2, 100.0, None, None),
+            point(3, 101.0, None, None),
+        ];
+        let gap = LifeGap {
+            after: "s1".into(),
+            before: "s2".into(),
+            from_s: 2.0,
+            to_s: 100.0,
+        };
+        let figure = life_figure(&report(points, vec![gap]));
+        let Panel::Spectrum(rms) = &figure.panels[0] else {
+            panic!("the RMS panel first");
+        };
+        assert_eq!(rms.x, [0.0, 1.0, 51.0, 100.0, 101.0]);
+        let y = &rms.series[0].y;
+        assert!(y[2].is_nan() && y.iter().filter(|v| v.is_nan()).count() == 1);
+        assert!(figure.notes.iter().any(|n| n.contains("1 gap(s)")));
+    }
 }

@@ -8,5 +8,6 @@ mod life;
 
 pub use figure::analysis_figure;
 pub use life::{
-    duration_text, life_figure, render_life_text, LifeReport, LifeSettingsReport, SkippedFile,
+    duration_text, life_figure, render_life_text, LifeGap, LifeReport, LifeSettingsReport,
+    SkippedFile,
 };
