@@ -238,3 +238,207 @@ fn a_bearingd_log_is_cut_into_windows_in_sample_time() {
     assert!(points[3]["source"].as_str().unwrap().ends_with(".mcap#3"));
     assert!(points.iter().all(|p| p["fault_score"].is_number()));
 }
+
+/// `bearingd run --fast` of `seconds` of the embedded default (a simulated sensor that
+/// develops an outer-race fault), `config` replacing it when given; returns the log's path.
+fn daemon_log(tag: &str, seconds: u32, config: Option<&Path>) -> std::path::PathBuf {
+    let data = scratch_dir(tag);
+    let duration = seconds.to_string();
+    let mut args = vec![
+        "run",
+        "--fast",
+        "--duration",
+        &duration,
+        "--data-dir",
+        data.to_str().unwrap(),
+        "--quiet",
+    ];
+    if let Some(config) = config {
+        args.extend(["--config", config.to_str().unwrap()]);
+    }
+    let out = bearingd(&args);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    bearingd_testdata::mcap_files(&data.join("mcap"))
+        .pop()
+        .expect("bearingd run wrote a log")
+}
+
+fn note_with<'a>(report: &'a Value, text: &str) -> Option<&'a str> {
+    report["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(Value::as_str)
+        .find(|n| n.contains(text))
+}
+
+/// Issue 33 item 5: on a daemon log the HW residual is the daemon's own (`/hw`), not
+/// identified again per window (0.8 s of CPU each); progress lines go to stderr in a pipe.
+#[test]
+fn a_daemon_log_s_hw_fits_are_used_not_identified_again() {
+    let log = daemon_log("trend-hw-log", 40, None);
+    let dir = log.parent().unwrap();
+    let args = ["trend", dir.to_str().unwrap(), "--format", "json"];
+    let out = lab(&args);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let points = report["points"].as_array().unwrap();
+    assert_eq!(points.len(), 40, "{report}");
+    let with_hw: Vec<&Value> = points
+        .iter()
+        .filter(|p| p["hw_residual_percent"].is_number())
+        .collect();
+    // One fit per twin re-fit (every 10 s of sample time), each from the log.
+    assert!((2..=5).contains(&with_hw.len()), "{}", with_hw.len());
+    assert!(with_hw.iter().all(|p| p["hw_from"] == "log"), "{with_hw:?}");
+    assert!(
+        note_with(&report, "the daemon's own fits").is_some(),
+        "{report}"
+    );
+    // In a pipe: plain progress lines, the last one complete.
+    let err = stderr(&out);
+    assert!(err.contains("trend: 1/1 files, 40 snapshots"), "{err}");
+}
+
+/// Without `/hw` in the log (HW off) the model is identified on each snapshot, said once.
+#[test]
+fn a_log_without_hw_fits_falls_back_to_identifying_and_says_so() {
+    let out = bearingd(&["config", "default"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.contains("hw_enabled = true"));
+    let config = scratch_dir("trend-hw-off").join("bearingd.toml");
+    std::fs::write(
+        &config,
+        text.replace("hw_enabled = true", "hw_enabled = false"),
+    )
+    .unwrap();
+    let log = daemon_log("trend-hw-off-log", 4, Some(&config));
+    let report = trend_json(&log, &["--baseline", "2"]);
+    let points = report["points"].as_array().unwrap();
+    assert_eq!(points.len(), 4, "{report}");
+    assert!(
+        points.iter().all(|p| p["hw_from"] == "fit"),
+        "every snapshot identified: {report}"
+    );
+    let notes: Vec<&str> = report["notes"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(Value::as_str)
+        .filter(|n| n.contains("hold no HW fit"))
+        .collect();
+    assert_eq!(notes.len(), 1, "said once: {report}");
+}
+
+/// Imports an IMS file as a log and copies it into `dir` under `name`.
+fn imported_as(ims: &Path, file: &str, dir: &Path, name: &str) {
+    let out_dir = scratch_dir("trend-import");
+    let out = bearingd(&[
+        "import",
+        ims.join(file).to_str().unwrap(),
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let log = bearingd_testdata::mcap_files(&out_dir)
+        .pop()
+        .expect("import wrote a log");
+    std::fs::copy(log, dir.join(name)).unwrap();
+}
+
+/// Issue 33 item 5: logs are placed by their anchor (`log_time_origin_ns`), not their names;
+/// the 50 min between two of them is a gap, said in the JSON and the table.
+#[test]
+fn logs_are_ordered_by_their_anchor_and_a_gap_between_them_is_shown() {
+    let Some(ims) = shared_data_dir("ims") else {
+        return;
+    };
+    let dir = scratch_dir("trend-anchor");
+    // The earlier recording under the later name, and the other way round.
+    let (early, late) = (
+        "bearingd-20300101T000000Z-000000.mcap",
+        "bearingd-20000101T000000Z-000000.mcap",
+    );
+    imported_as(&ims, "2003.10.22.12.14.13", &dir, early);
+    imported_as(&ims, "2003.10.22.13.04.13", &dir, late);
+    let options = [
+        "--window",
+        "0.25",
+        "--baseline",
+        "2",
+        "--no-hw",
+        "--rpm",
+        "2000",
+        "--bearing",
+        "rexnord-za-2115",
+    ];
+    let report = trend_json(&dir, &options);
+    assert!(report["skipped"].as_array().unwrap().is_empty(), "{report}");
+    let points = report["points"].as_array().unwrap();
+    let sources: Vec<&str> = points
+        .iter()
+        .map(|p| p["source"].as_str().unwrap())
+        .collect();
+    assert_eq!(sources.len(), 8, "{sources:?}");
+    assert!(
+        sources[..4].iter().all(|s| s.starts_with(early)),
+        "{sources:?}"
+    );
+    assert!(
+        sources[4..].iter().all(|s| s.starts_with(late)),
+        "{sources:?}"
+    );
+    let times: Vec<f64> = points
+        .iter()
+        .map(|p| p["time_s"].as_f64().unwrap())
+        .collect();
+    assert_eq!(&times[..4], [0.0, 0.25, 0.5, 0.75]);
+    assert!((times[4] - 3000.0).abs() < 1.0, "{times:?}");
+    let gaps = report["gaps"].as_array().unwrap();
+    assert_eq!(gaps.len(), 1, "{report}");
+    // Each IMS file: 20,480 samples at 20 kHz.
+    assert!(
+        (gaps[0]["from_s"].as_f64().unwrap() - 1.024).abs() < 1e-6,
+        "{gaps:?}"
+    );
+    assert_eq!(gaps[0]["to_s"].as_f64().unwrap(), times[4]);
+    assert!(gaps[0]["before"].as_str().unwrap().starts_with(late));
+
+    let mut args = vec!["trend", dir.to_str().unwrap(), "--format", "table"];
+    args.extend_from_slice(&options);
+    let out = lab(&args);
+    let table = String::from_utf8_lossy(&out.stdout);
+    let rows: Vec<&str> = table.lines().skip(2).collect();
+    assert!(rows[4].starts_with("| (gap) | 1.0 to 3000.0 |"), "{table}");
+}
+
+/// Issue 33 item 5: two `run --fast` logs (dated in sample time, so the second starts before
+/// the first ends) are read one after the other, none skipped, whatever their names.
+#[test]
+fn fast_runs_overlapping_in_time_are_placed_one_after_the_other() {
+    let first = daemon_log("trend-fast-1", 6, None);
+    let second = daemon_log("trend-fast-2", 6, None);
+    let dir = scratch_dir("trend-fast");
+    std::fs::copy(&first, dir.join("bearingd-20991231T000000Z-000000.mcap")).unwrap();
+    std::fs::copy(&second, dir.join("bearingd-20000101T000000Z-000000.mcap")).unwrap();
+    let report = trend_json(&dir, &["--baseline", "2", "--no-hw"]);
+    assert!(report["skipped"].as_array().unwrap().is_empty(), "{report}");
+    let points = report["points"].as_array().unwrap();
+    assert_eq!(points.len(), 12, "{report}");
+    assert!(points[0]["source"]
+        .as_str()
+        .unwrap()
+        .starts_with("bearingd-2099"));
+    let times: Vec<f64> = points
+        .iter()
+        .map(|p| p["time_s"].as_f64().unwrap())
+        .collect();
+    for (i, t) in times.iter().enumerate() {
+        assert!((t - i as f64).abs() < 1e-6, "{times:?}");
+    }
+    assert!(
+        note_with(&report, "placed right after").is_some(),
+        "{report}"
+    );
+}

@@ -9,15 +9,20 @@
 //! Reading and timing files happens here; the life itself is sans-IO ([`LifeTracker`]).
 
 use crate::analysis::health::CONFIRM_WINDOWS;
-use crate::life::{hindsight, LifeSettings, LifeTracker};
+use crate::life::{hindsight, HwFrom, LifeSettings, LifeTracker, SnapshotHw};
 use crate::offline::{resolve_conditions, AnalyzeRequest, OfflineError};
-use crate::recording::{read_recording, time_from_name};
-use crate::report::{life_figure, render_life_text, LifeReport, LifeSettingsReport, SkippedFile};
+use crate::recording::{read_recording_placed, time_from_name, LogPlacement, LoggedHwFit, Segment};
+use crate::report::{
+    life_figure, render_life_text, LifeGap, LifeReport, LifeSettingsReport, SkippedFile,
+};
 use bearingd::cli::{CliError, RecordingArgs};
+use bearingd::mcap_log::read_header;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::BTreeSet;
+use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum TrendFormat {
@@ -75,7 +80,10 @@ pub struct TrendArgs {
 /// A file to read, placed in time.
 struct Placed {
     path: PathBuf,
+    /// Seconds: a log's wall-clock anchor (its sample 0), else the time its name states.
     seconds: f64,
+    /// A log's place in its run (1, 2, … after each rotation); 0 for other files.
+    sequence: u64,
 }
 
 /// What a directory holds: snapshots in time order, files that could not be placed, files
@@ -86,6 +94,17 @@ struct Listing {
     ignored: Vec<String>,
 }
 
+/// One snapshot cut from a file: its samples and where they sit.
+struct Piece<'a> {
+    samples: &'a [f64],
+    /// Seconds after the start of the file's segment (`segment`), or of the file.
+    offset_s: f64,
+    /// Index of the log's segment it lies in.
+    segment: usize,
+    /// A log's samples `[from, to)` in its own count.
+    log_samples: Option<(u64, u64)>,
+}
+
 pub fn run(args: &TrendArgs) -> Result<(), CliError> {
     let settings = settings_from(args)?;
     let Listing {
@@ -93,31 +112,27 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         mut skipped,
         ignored,
     } = list_snapshots(args)?;
-    let first_s = placed.first().map_or(0.0, |p| p.seconds);
     let mut life = LifeTracker::new(settings.clone());
     let mut points = Vec::new();
     let mut notes: BTreeSet<String> = BTreeSet::new();
     let mut channel = None;
-    let progress = ProgressBar::with_draw_target(
-        Some(placed.len() as u64),
-        ProgressDrawTarget::stderr_with_hz(4),
-    );
-    if let Ok(style) = ProgressStyle::with_template("{bar:40} {pos}/{len} snapshots, {eta} left") {
-        progress.set_style(style);
-    }
-    for file in &placed {
-        progress.inc(1);
+    let mut clock = LogClock::default();
+    let mut hw_note = HwNote::default();
+    let progress = Progress::start(placed.len());
+    for (done, file) in placed.iter().enumerate() {
+        progress.step(done, points.len());
         let name = file_label(&file.path);
-        let recording = match read_recording(&file.path, &args.recording.read_options()) {
-            Ok(r) => r,
-            Err(e) => {
-                skipped.push(SkippedFile {
-                    file: name,
-                    error: e.to_string(),
-                });
-                continue;
-            }
-        };
+        let (recording, placement) =
+            match read_recording_placed(&file.path, &args.recording.read_options()) {
+                Ok(r) => r,
+                Err(e) => {
+                    skipped.push(SkippedFile {
+                        file: name,
+                        error: e.to_string(),
+                    });
+                    continue;
+                }
+            };
         let request = AnalyzeRequest {
             file: Some(file.path.clone()),
             read: args.recording.read_options(),
@@ -158,14 +173,10 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         };
         channel.get_or_insert_with(|| recording.channel.clone());
         let window = ((args.window * fs_hz).round() as usize).max(1);
-        let pieces: Vec<&[f64]> = if recording.samples.len() * 2 > window * 3 {
-            recording
-                .samples
-                .chunks(window)
-                .filter(|c| c.len() * 2 >= window)
-                .collect()
-        } else {
-            vec![&recording.samples[..]]
+        let pieces = cut(&recording.samples, placement.as_ref(), window, fs_hz);
+        let logged_hw = match &placement {
+            Some(p) if settings.hw.is_some() => hw_note.choose(&name, &p.hw_fits),
+            _ => None,
         };
         let several = pieces.len() > 1;
         for (k, piece) in pieces.into_iter().enumerate() {
@@ -174,8 +185,15 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
             } else {
                 name.clone()
             };
-            let time_s = file.seconds - first_s + k as f64 * window as f64 / fs_hz;
-            match life.push(&source, time_s, piece, fs_hz, freqs.as_ref()) {
+            let time_s = match &placement {
+                Some(p) => clock.place(file, p, piece.segment, fs_hz, &source),
+                None => clock.relative(file.seconds),
+            } + piece.offset_s;
+            let hw = match (logged_hw, piece.log_samples) {
+                (Some(fits), Some(span)) => SnapshotHw::Logged(residual_in(fits, span)),
+                _ => SnapshotHw::Identify,
+            };
+            match life.push_with_hw(&source, time_s, piece.samples, fs_hz, freqs.as_ref(), hw) {
                 Ok(point) => points.push(point),
                 Err(e) => skipped.push(SkippedFile {
                     file: source,
@@ -184,7 +202,7 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
             }
         }
     }
-    progress.finish_and_clear();
+    progress.finish(placed.len(), points.len());
     if points.is_empty() {
         let mut message = format!("{}: no usable snapshot", args.path.display());
         for s in &skipped {
@@ -195,6 +213,8 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         }
         return Err(CliError::input(message));
     }
+    notes.extend(hw_note.notes(channel.as_deref().unwrap_or_default(), &points));
+    notes.extend(clock.notes());
     let report = LifeReport {
         path: args.path.display().to_string(),
         channel: channel.unwrap_or_default(),
@@ -209,6 +229,7 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         },
         events: life.events().to_vec(),
         hindsight: hindsight(&points),
+        gaps: clock.gaps,
         points,
         skipped,
         ignored,
@@ -235,6 +256,259 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         }
     }
     Ok(())
+}
+
+/// The snapshots of one file: the whole file when it is at most 1.5 windows long, else
+/// windows of `window` samples (a last one shorter than half a window is left out), cut
+/// inside each run of contiguous samples of a log so that no window spans a gap.
+fn cut<'a>(
+    samples: &'a [f64],
+    placement: Option<&LogPlacement>,
+    window: usize,
+    fs_hz: f64,
+) -> Vec<Piece<'a>> {
+    let whole = [Segment {
+        offset: 0,
+        first_sample: 0,
+        len: samples.len(),
+    }];
+    let segments = match placement {
+        Some(p) if !p.segments.is_empty() => &p.segments[..],
+        _ => &whole[..],
+    };
+    let logged = placement.is_some();
+    if samples.len() * 2 <= window * 3 {
+        let first = segments[0].first_sample;
+        return vec![Piece {
+            samples,
+            offset_s: 0.0,
+            segment: 0,
+            log_samples: logged.then_some((first, first + samples.len() as u64)),
+        }];
+    }
+    let mut pieces = Vec::new();
+    for (index, segment) in segments.iter().enumerate() {
+        let Some(part) = samples.get(segment.offset..segment.offset + segment.len) else {
+            continue;
+        };
+        for (k, chunk) in part.chunks(window).enumerate() {
+            if chunk.len() * 2 < window {
+                continue;
+            }
+            let from = segment.first_sample + (k * window) as u64;
+            pieces.push(Piece {
+                samples: chunk,
+                offset_s: (k * window) as f64 / fs_hz,
+                segment: index,
+                log_samples: logged.then_some((from, from + chunk.len() as u64)),
+            });
+        }
+    }
+    pieces
+}
+
+/// The residual (%) of the last HW fit the daemon logged whose signal ends in `(from, to]`.
+fn residual_in(fits: &[LoggedHwFit], (from, to): (u64, u64)) -> Option<f64> {
+    fits.iter()
+        .rfind(|f| f.end_sample > from && f.end_sample <= to)
+        .and_then(|f| f.accuracy_simulation)
+        .map(|accuracy| 100.0 - accuracy)
+}
+
+/// Which HW residuals a life over logs uses, and what to say about it once.
+#[derive(Default)]
+struct HwNote {
+    /// Logs whose HW fits were used, and logs that had none (so the model was identified).
+    logged: usize,
+    identified: Vec<String>,
+}
+
+impl HwNote {
+    /// The fits of a log to use, or `None` (identify the model) when it logged none.
+    fn choose<'a>(&mut self, name: &str, fits: &'a [LoggedHwFit]) -> Option<&'a [LoggedHwFit]> {
+        if fits.is_empty() {
+            self.identified.push(name.to_string());
+            None
+        } else {
+            self.logged += 1;
+            Some(fits)
+        }
+    }
+
+    fn notes(&self, channel: &str, points: &[crate::life::LifePoint]) -> Vec<String> {
+        let mut notes = Vec::new();
+        if self.logged > 0 {
+            let with = points
+                .iter()
+                .filter(|p| p.hw_from == Some(HwFrom::Log))
+                .count();
+            notes.push(format!(
+                "HW residual: the daemon's own fits, read from /hw/{channel} ({with} of {} snapshots hold one: the daemon fits once per twin re-fit, twin.refit_period_s), not identified again",
+                points.len()
+            ));
+        }
+        if let Some(first) = self.identified.first() {
+            notes.push(format!(
+                "HW residual: {} log(s) hold no HW fit (/hw/{channel}: HW off, or a log of an older bearingd; the first: {first}): the model was identified on each of their snapshots instead (slow: about 0.8 s of CPU per 1 s window; --no-hw skips it)",
+                self.identified.len()
+            ));
+        }
+        notes
+    }
+}
+
+/// Places the snapshots of logs in time: each log at its wall-clock anchor plus its sample
+/// index over the sample rate; a run that starts before the previous one ends (runs made
+/// with `run --fast` are dated in sample time, so they overlap in wall-clock time; or a sensor
+/// restart) is moved to start where the previous ended; a jump forward longer than half a
+/// window is a gap.
+#[derive(Default)]
+struct LogClock {
+    /// Absolute seconds of the first snapshot: the life's time 0.
+    first_s: Option<f64>,
+    /// The run (anchor) being placed, and how far its samples were moved (s).
+    run: Option<(Option<u64>, u64)>,
+    shift_s: f64,
+    /// End of the last segment placed (absolute s) and the snapshot before it.
+    last_end_s: Option<f64>,
+    last_source: String,
+    /// The segment placed last: (file, segment index).
+    placed_segment: Option<(PathBuf, usize)>,
+    moved: usize,
+    gaps: Vec<LifeGap>,
+}
+
+impl LogClock {
+    /// Seconds since the first snapshot of a file placed at `absolute_s`.
+    fn relative(&mut self, absolute_s: f64) -> f64 {
+        absolute_s - *self.first_s.get_or_insert(absolute_s)
+    }
+
+    /// Time (s since the first snapshot) of the start of `segment` of the log `file`, and
+    /// `source` is its snapshot (a gap before it names it).
+    fn place(
+        &mut self,
+        file: &Placed,
+        placement: &LogPlacement,
+        segment: usize,
+        fs_hz: f64,
+        source: &str,
+    ) -> f64 {
+        let Some(seg) = placement.segments.get(segment) else {
+            return self.relative(file.seconds);
+        };
+        let anchor_s = placement
+            .origin_ns
+            .map_or(file.seconds, |ns| ns as f64 / 1e9);
+        let run = (placement.run_id, placement.origin_ns.unwrap_or_default());
+        if self.run != Some(run) {
+            self.run = Some(run);
+            self.shift_s = 0.0;
+        }
+        let key = (file.path.clone(), segment);
+        let mut start_s = anchor_s + seg.first_sample as f64 / fs_hz + self.shift_s;
+        if self.placed_segment.as_ref() != Some(&key) {
+            // A new segment: check it against the end of the one before.
+            if let Some(end_s) = self.last_end_s {
+                let tolerance = 1e-3 + 1.0 / fs_hz;
+                if start_s < end_s - tolerance {
+                    self.shift_s += end_s - start_s;
+                    start_s = end_s;
+                    self.moved += 1;
+                } else if start_s > end_s + tolerance.max(0.5) {
+                    let first = *self.first_s.get_or_insert(start_s);
+                    self.gaps.push(LifeGap {
+                        after: self.last_source.clone(),
+                        before: source.to_string(),
+                        from_s: end_s - first,
+                        to_s: start_s - first,
+                    });
+                }
+            }
+            self.last_end_s = Some(start_s + seg.len as f64 / fs_hz);
+            self.placed_segment = Some(key);
+        }
+        self.last_source = source.to_string();
+        self.relative(start_s)
+    }
+
+    fn notes(&self) -> Vec<String> {
+        let mut notes = Vec::new();
+        if self.moved > 0 {
+            notes.push(format!(
+                "{} run(s) or file(s) of logs start before the previous one ends (logs made with bearingd run --fast are dated in sample time; or a sensor restart): each was placed right after the one before, so times after them are not wall-clock times",
+                self.moved
+            ));
+        }
+        if !self.gaps.is_empty() {
+            notes.push(format!(
+                "{} gap(s) in the logs (no samples for longer than half a window, e.g. between runs): shown as gaps, the lines break there",
+                self.gaps.len()
+            ));
+        }
+        notes
+    }
+}
+
+/// Progress on stderr: a bar on a terminal, plain lines elsewhere (a pipe, a log file), at
+/// each quarter of the files and at least every 10 s.
+struct Progress {
+    bar: Option<ProgressBar>,
+    total: usize,
+    started: Instant,
+    last_line: std::cell::Cell<Instant>,
+}
+
+impl Progress {
+    fn start(total: usize) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = ProgressBar::with_draw_target(
+                Some(total as u64),
+                ProgressDrawTarget::stderr_with_hz(4),
+            );
+            if let Ok(style) =
+                ProgressStyle::with_template("trend {bar:40} {pos}/{len} files, {eta} left")
+            {
+                bar.set_style(style);
+            }
+            bar
+        });
+        let now = Instant::now();
+        Progress {
+            bar,
+            total,
+            started: now,
+            last_line: std::cell::Cell::new(now),
+        }
+    }
+
+    /// `done` files read so far, `snapshots` taken from them.
+    fn step(&self, done: usize, snapshots: usize) {
+        if let Some(bar) = &self.bar {
+            bar.set_position(done as u64);
+            return;
+        }
+        let quarter = done > 0 && done * 4 / self.total != (done - 1) * 4 / self.total;
+        if quarter || self.last_line.get().elapsed().as_secs_f64() >= 10.0 {
+            self.line(done, snapshots);
+        }
+    }
+
+    fn finish(&self, done: usize, snapshots: usize) {
+        match &self.bar {
+            Some(bar) => bar.finish_and_clear(),
+            None => self.line(done, snapshots),
+        }
+    }
+
+    fn line(&self, done: usize, snapshots: usize) {
+        eprintln!(
+            "trend: {done}/{} files, {snapshots} snapshots, {:.1} s",
+            self.total,
+            self.started.elapsed().as_secs_f64()
+        );
+        self.last_line.set(Instant::now());
+    }
 }
 
 fn settings_from(args: &TrendArgs) -> Result<LifeSettings, CliError> {
@@ -320,10 +594,17 @@ fn list_snapshots(args: &TrendArgs) -> Result<Listing, CliError> {
     let mut unplaced = Vec::new();
     let mut ignored = Vec::new();
     for file in files {
-        if let Some(t) = time_from_name(&file) {
+        if let Some((seconds, sequence)) = log_anchor(&file) {
+            placed.push(Placed {
+                path: file,
+                seconds,
+                sequence,
+            });
+        } else if let Some(t) = time_from_name(&file) {
             placed.push(Placed {
                 path: file,
                 seconds: t.seconds,
+                sequence: 0,
             });
         } else if is_mcap(&file) || path.is_file() {
             unplaced.push(file);
@@ -343,10 +624,15 @@ fn list_snapshots(args: &TrendArgs) -> Result<Listing, CliError> {
             placed.extend(unplaced.into_iter().enumerate().map(|(i, path)| Placed {
                 path,
                 seconds: start + i as f64 * interval,
+                sequence: 0,
             }));
         }
         None if path.is_file() && unplaced.len() == 1 => {
-            placed.extend(unplaced.into_iter().map(|path| Placed { path, seconds: 0.0 }));
+            placed.extend(unplaced.into_iter().map(|path| Placed {
+                path,
+                seconds: 0.0,
+                sequence: 0,
+            }));
         }
         None => skipped.extend(unplaced.into_iter().map(|f| SkippedFile {
             file: file_label(&f),
@@ -356,12 +642,31 @@ fn list_snapshots(args: &TrendArgs) -> Result<Listing, CliError> {
             ),
         })),
     }
-    placed.sort_by(|a, b| a.seconds.total_cmp(&b.seconds).then(a.path.cmp(&b.path)));
+    // Logs by their anchor, then their place in the run: not by name (a log's name is the
+    // time it was opened, in sample time for `run --fast`).
+    placed.sort_by(|a, b| {
+        a.seconds
+            .total_cmp(&b.seconds)
+            .then(a.sequence.cmp(&b.sequence))
+            .then(a.path.cmp(&b.path))
+    });
     Ok(Listing {
         placed,
         skipped,
         ignored,
     })
+}
+
+/// A bearingd log's wall-clock anchor (s since the epoch of its sample 0,
+/// `log_time_origin_ns`) and its sequence in its run; `None` for other files and for logs
+/// that state no anchor (placed by their name).
+fn log_anchor(path: &Path) -> Option<(f64, u64)> {
+    if !is_mcap(path) {
+        return None;
+    }
+    let header = read_header(path).ok()?;
+    let origin_ns = header.origin_ns?;
+    Some((origin_ns as f64 / 1e9, header.sequence.unwrap_or_default()))
 }
 
 fn is_mcap(path: &Path) -> bool {
@@ -380,7 +685,16 @@ fn table(report: &LifeReport) -> String {
     let mut out = String::from(
         "| snapshot | time (s) | life % | RMS (g) | kurtosis | HW residual % | fault score | stage |\n|---|---|---|---|---|---|---|---|\n",
     );
+    let mut gaps = report.gaps.iter().peekable();
     for p in &report.points {
+        while let Some(gap) = gaps.next_if(|g| g.to_s <= p.time_s) {
+            out.push_str(&format!(
+                "| (gap) | {:.1} to {:.1} | | | | | | no samples for {} |\n",
+                gap.from_s,
+                gap.to_s,
+                crate::report::duration_text(gap.to_s - gap.from_s)
+            ));
+        }
         out.push_str(&format!(
             "| {} | {:.1} | {:.1} | {:.3} | {:.2} | {} | {} | {} |\n",
             p.source,
