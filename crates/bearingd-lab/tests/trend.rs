@@ -442,3 +442,41 @@ fn fast_runs_overlapping_in_time_are_placed_one_after_the_other() {
         "{report}"
     );
 }
+
+/// Issue 33 item 5: without `--rpm` the FEMTO manifest's speed (1800 rpm) is used, so every
+/// snapshot has its fault score, and the note says where the speed came from.
+#[test]
+fn the_manifest_s_speed_gives_the_fault_score_without_rpm() {
+    let Some(femto) = shared_data_dir("femto") else {
+        return;
+    };
+    let dir = scratch_dir("trend-manifest").join("Bearing1_2");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut manifest = String::new();
+    for (i, line) in std::fs::read_to_string(femto.join("manifest.csv"))
+        .unwrap()
+        .lines()
+        .enumerate()
+    {
+        // The header and the first 6 snapshots of Bearing1_2, beside copies of their files.
+        if i == 0 || (line.starts_with("Bearing1_2/") && manifest.lines().count() < 7) {
+            manifest.push_str(line);
+            manifest.push('\n');
+            if i > 0 {
+                let file = line.split(',').next().unwrap();
+                std::fs::copy(femto.join(file), dir.parent().unwrap().join(file)).unwrap();
+            }
+        }
+    }
+    std::fs::write(dir.parent().unwrap().join("manifest.csv"), &manifest).unwrap();
+    let report = trend_json(&dir, &["--baseline", "3", "--no-hw"]);
+    let points = report["points"].as_array().unwrap();
+    assert_eq!(points.len(), 6, "{report}");
+    assert!(
+        points.iter().all(|p| p["fault_score"].is_number()),
+        "{report}"
+    );
+    let note = note_with(&report, "the data set's manifest").unwrap_or_default();
+    assert!(note.contains("1800 rpm"), "{report}");
+    assert!(note_with(&report, "give --rpm").is_none(), "{report}");
+}

@@ -9,6 +9,7 @@
 //! Reading and timing files happens here; the life itself is sans-IO ([`LifeTracker`]).
 
 use crate::analysis::health::CONFIRM_WINDOWS;
+use crate::evaluate::recordings::Manifest;
 use crate::life::{hindsight, HwFrom, LifeSettings, LifeTracker, SnapshotHw};
 use crate::offline::{resolve_conditions, AnalyzeRequest, OfflineError};
 use crate::recording::{read_recording_placed, time_from_name, LogPlacement, LoggedHwFit, Segment};
@@ -19,7 +20,7 @@ use bearingd::cli::{CliError, RecordingArgs};
 use bearingd::mcap_log::read_header;
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -118,6 +119,7 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
     let mut channel = None;
     let mut clock = LogClock::default();
     let mut hw_note = HwNote::default();
+    let manifest = ManifestSpeeds::find(&args.path);
     let progress = Progress::start(placed.len());
     for (done, file) in placed.iter().enumerate() {
         progress.step(done, points.len());
@@ -137,7 +139,10 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
             file: Some(file.path.clone()),
             read: args.recording.read_options(),
             fs_hz: args.recording.fs,
-            rpm: args.recording.rpm,
+            rpm: args
+                .recording
+                .rpm
+                .or_else(|| manifest.rpm_of(&file.path, &mut notes)),
             bearing: args.recording.bearing.clone(),
             ..AnalyzeRequest::default()
         };
@@ -313,6 +318,57 @@ fn residual_in(fits: &[LoggedHwFit], (from, to): (u64, u64)) -> Option<f64> {
         .rfind(|f| f.end_sample > from && f.end_sample <= to)
         .and_then(|f| f.accuracy_simulation)
         .map(|accuracy| 100.0 - accuracy)
+}
+
+/// The shaft speeds a data set's `manifest.csv` gives its files (FEMTO: 1800 rpm for
+/// Bearing1_2), in the snapshots' folder or the one above it: used when `--rpm` is not given,
+/// so that the fault score is computed whenever the speed is known.
+#[derive(Default)]
+struct ManifestSpeeds {
+    path: PathBuf,
+    rpm: HashMap<PathBuf, f64>,
+}
+
+impl ManifestSpeeds {
+    fn find(path: &Path) -> Self {
+        let dir = if path.is_dir() {
+            Some(path)
+        } else {
+            path.parent()
+        };
+        let candidates = dir
+            .into_iter()
+            .flat_map(|d| [Some(d), d.parent()])
+            .flatten()
+            .map(|d| d.join("manifest.csv"));
+        for candidate in candidates {
+            let Ok(manifest) = Manifest::read(&candidate) else {
+                continue;
+            };
+            let rpm: HashMap<PathBuf, f64> = manifest
+                .records
+                .iter()
+                .filter_map(|r| Some((r.file.canonicalize().ok()?, r.rpm?)))
+                .collect();
+            if !rpm.is_empty() {
+                return ManifestSpeeds {
+                    path: candidate,
+                    rpm,
+                };
+            }
+        }
+        ManifestSpeeds::default()
+    }
+
+    /// The manifest's speed of `file`, said in a note.
+    fn rpm_of(&self, file: &Path, notes: &mut BTreeSet<String>) -> Option<f64> {
+        let rpm = *self.rpm.get(&file.canonicalize().ok()?)?;
+        notes.insert(format!(
+            "speed from {} (the data set's manifest: {rpm} rpm for its files); --rpm overrides it",
+            self.path.display()
+        ));
+        Some(rpm)
+    }
 }
 
 /// Which HW residuals a life over logs uses, and what to say about it once.
