@@ -558,7 +558,7 @@ pub fn life_figure(report: &LifeReport) -> Figure {
         let mut score = panel("envelope fault score", x);
         score.series = vec![Series {
             label: if floor {
-                "strongest fault score (1.0: the floor)".into()
+                "fault score (at its floor)".into()
             } else {
                 "strongest fault score".into()
             },
