@@ -540,7 +540,7 @@ pub fn life_figure(report: &LifeReport) -> Figure {
         hw.x_range = Some((x.first().copied().unwrap_or(0.0), end_x));
         hw.series = vec![Series {
             label: if logged {
-                "HW residual, order 0 (daemon's fits)".into()
+                "HW residual (daemon's fits)".into()
             } else {
                 "HW free-run residual, order 0".into()
             },
