@@ -82,6 +82,10 @@ pub struct LogPlacement {
     pub segments: Vec<Segment>,
     /// The HW fits the daemon logged for this channel, in log order.
     pub hw_fits: Vec<LoggedHwFit>,
+    /// `twin.hw_enabled` of the configuration the log records: whether the daemon fitted the
+    /// HW model at all (a file may hold no fit yet: cut before the first re-fit); `None` when
+    /// the log does not say.
+    pub hw_enabled: Option<bool>,
 }
 
 impl Joined {
@@ -333,6 +337,11 @@ pub fn read_log(
         run_id: header.as_ref().and_then(|h| h.run_id),
         segments: j.segments,
         hw_fits,
+        hw_enabled: header
+            .as_ref()
+            .and_then(|h| h.config_json.as_deref())
+            .and_then(|json| serde_json::from_str::<serde_json::Value>(json).ok())
+            .and_then(|config| config["twin"]["hw_enabled"].as_bool()),
     };
     let recording = Recording {
         path: path.to_path_buf(),

@@ -480,3 +480,15 @@ fn the_manifest_s_speed_gives_the_fault_score_without_rpm() {
     assert!(note.contains("1800 rpm"), "{report}");
     assert!(note_with(&report, "give --rpm").is_none(), "{report}");
 }
+
+/// A log whose daemon fits the HW model but holds no fit yet (4 s, before the first re-fit
+/// at 10 s) is not identified again: its snapshots have no HW residual.
+#[test]
+fn a_log_of_a_daemon_with_hw_on_is_never_identified_again() {
+    let log = daemon_log("trend-hw-none-yet", 4, None);
+    let report = trend_json(&log, &["--baseline", "2"]);
+    let points = report["points"].as_array().unwrap();
+    assert_eq!(points.len(), 4, "{report}");
+    assert!(points.iter().all(|p| p["hw_from"].is_null()), "{report}");
+    assert!(note_with(&report, "hold no HW fit").is_none(), "{report}");
+}

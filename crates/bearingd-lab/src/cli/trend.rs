@@ -180,7 +180,7 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         let window = ((args.window * fs_hz).round() as usize).max(1);
         let pieces = cut(&recording.samples, placement.as_ref(), window, fs_hz);
         let logged_hw = match &placement {
-            Some(p) if settings.hw.is_some() => hw_note.choose(&name, &p.hw_fits),
+            Some(p) if settings.hw.is_some() => hw_note.choose(&name, p),
             _ => None,
         };
         let several = pieces.len() > 1;
@@ -380,14 +380,16 @@ struct HwNote {
 }
 
 impl HwNote {
-    /// The fits of a log to use, or `None` (identify the model) when it logged none.
-    fn choose<'a>(&mut self, name: &str, fits: &'a [LoggedHwFit]) -> Option<&'a [LoggedHwFit]> {
-        if fits.is_empty() {
+    /// The fits of a log to use (maybe none yet, when its configuration says the daemon fits
+    /// the model), or `None` (identify the model) when it logged none and says nothing or that
+    /// HW was off.
+    fn choose<'a>(&mut self, name: &str, log: &'a LogPlacement) -> Option<&'a [LoggedHwFit]> {
+        if log.hw_fits.is_empty() && log.hw_enabled != Some(true) {
             self.identified.push(name.to_string());
             None
         } else {
             self.logged += 1;
-            Some(fits)
+            Some(&log.hw_fits)
         }
     }
 
