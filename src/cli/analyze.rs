@@ -147,7 +147,7 @@ pub fn run_with(args: &AnalyzeArgs, on_record: &mut OnRecord) -> Result<(), CliE
             &args.files,
             &args.recording,
             args.hw_states.into(),
-            args.format,
+            args.format == OutputFormat::Json,
         );
     }
     let config = match &args.config {

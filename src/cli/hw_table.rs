@@ -5,7 +5,6 @@
 //!
 //! The identification itself is sans-IO (`twin::hw`); the clock that times it lives here.
 
-use super::analyze::OutputFormat;
 use super::{CliError, RecordingArgs};
 use crate::recording::read_recording;
 use crate::twin::hw::{identify_record, HwConfig, StateFilter};
@@ -62,14 +61,14 @@ struct HwTable {
     failures: Vec<String>,
 }
 
-/// `--format text` and `table` print the Markdown tables; `json` one document with the same
-/// numbers. Progress goes to stderr: redrawn in place on a terminal, one line per record in a
+/// The Markdown tables (`--format text` and `table`), or with `json` one document with the
+/// same numbers. Progress goes to stderr: redrawn in place on a terminal, one line per record in a
 /// pipe.
 pub fn run(
     files: &[PathBuf],
     recording: &RecordingArgs,
     states: StateFilter,
-    format: OutputFormat,
+    json: bool,
 ) -> Result<(), CliError> {
     let terminal = std::io::stderr().is_terminal();
     let mut records = Vec::new();
@@ -105,12 +104,13 @@ pub fn run(
         records,
         failures,
     };
-    match format {
-        OutputFormat::Json => println!(
+    if json {
+        println!(
             "{}",
             serde_json::to_string_pretty(&table).map_err(CliError::input)?
-        ),
-        OutputFormat::Text | OutputFormat::Table => print_markdown(&table),
+        );
+    } else {
+        print_markdown(&table);
     }
     match table.failures.len() {
         0 => Ok(()),
