@@ -521,31 +521,23 @@ fn host_node_id() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::messages::{ChannelId, FaultKind, FlagLevel, HealthStage};
+    use crate::messages::{ChannelId, FaultKind, HealthStage};
 
     fn status() -> ChannelStatus {
         ChannelStatus {
-            channel: ChannelId {
-                sensor: "s1".into(),
-                axis: "radial".into(),
-            },
-            rpm: Some(1772.0),
-            speed_source: SpeedSource::Fixed,
             samples: 25_600,
             seconds: 1.0,
             band_hz: Some([1067.0, 2133.0]),
             top_fault: Some(FaultKind::Cage),
-            top_score: 0.0,
-            flags: [FlagLevel::Ok; 4],
-            stage: HealthStage::Learning,
-            gaps: 0,
-            missing_samples: 0,
-            twin_hypothesis: None,
-            twin_error: None,
-            sensor_lost: false,
-            flag_changes: 0,
-            readings: Vec::new(),
-            detector_flags: Vec::new(),
+            ..ChannelStatus::new(
+                ChannelId {
+                    sensor: "s1".into(),
+                    axis: "radial".into(),
+                },
+                Some(1772.0),
+                SpeedSource::Fixed,
+                HealthStage::Learning,
+            )
         }
     }
 

@@ -145,6 +145,35 @@ pub struct ChannelStatus {
 }
 
 impl ChannelStatus {
+    /// A channel before its first sample: every flag ok, the registry's detector flags too.
+    pub fn new(
+        channel: ChannelId,
+        rpm: Option<f64>,
+        speed_source: SpeedSource,
+        stage: HealthStage,
+    ) -> Self {
+        ChannelStatus {
+            channel,
+            rpm,
+            speed_source,
+            samples: 0,
+            seconds: 0.0,
+            band_hz: None,
+            top_fault: None,
+            top_score: 0.0,
+            flags: [FlagLevel::Ok; 4],
+            stage,
+            gaps: 0,
+            missing_samples: 0,
+            twin_hypothesis: None,
+            twin_error: None,
+            sensor_lost: false,
+            flag_changes: 0,
+            readings: Vec::new(),
+            detector_flags: all_flags().map(|f| (f.name, FlagLevel::Ok)).collect(),
+        }
+    }
+
     /// The raised flags as `fault=level` joined by commas (`outer_race=alarm,ball=watch`, the
     /// velocity zone flag as `iso_zone=watch`), or `ok` when none is raised.
     pub fn flags_summary(&self) -> String {
@@ -374,26 +403,12 @@ impl Pipeline {
                     );
                 }
                 turn += 1;
-                let status = ChannelStatus {
-                    channel: id.clone(),
-                    rpm: monitor.shaft_hz().map(|hz| hz * 60.0),
-                    speed_source: sensor.speed.source(),
-                    samples: 0,
-                    seconds: 0.0,
-                    band_hz: None,
-                    top_fault: None,
-                    top_score: 0.0,
-                    flags: [FlagLevel::Ok; 4],
-                    stage: monitor.health().stage(),
-                    gaps: 0,
-                    missing_samples: 0,
-                    twin_hypothesis: None,
-                    twin_error: None,
-                    sensor_lost: false,
-                    flag_changes: 0,
-                    readings: Vec::new(),
-                    detector_flags: all_flags().map(|f| (f.name, FlagLevel::Ok)).collect(),
-                };
+                let status = ChannelStatus::new(
+                    id.clone(),
+                    monitor.shaft_hz().map(|hz| hz * 60.0),
+                    sensor.speed.source(),
+                    monitor.health().stage(),
+                );
                 let fs_hz = sensor.sample_rate_hz;
                 channels.insert(
                     id,
