@@ -286,8 +286,9 @@ fn stage_color(stage: HealthStage) -> Option<Color> {
     }
 }
 
-/// Said on the figure when the fault score never leaves its floor.
-const FLAT_SCORE_NOTE: &str = "fault score 1.0 on every snapshot: no fault line stands above the noise floor of these snapshots (docs/HEALTH.md says why)";
+/// Said on the figure, instead of a flat panel, when the fault score never leaves its floor.
+const FLAT_SCORE_NOTE: &str =
+    "no fault-score panel: 1.0 (its floor) on every snapshot, no fault line above the noise (docs/HEALTH.md)";
 
 /// The life time axis: seconds per unit and the unit's name, chosen by the life's span.
 fn time_unit(span_s: f64) -> (f64, &'static str) {
@@ -549,19 +550,17 @@ pub fn life_figure(report: &LifeReport) -> Figure {
         }];
         figure = figure.with_panel(hw);
     }
+    // A score that never leaves its floor would draw a flat line: said in a note instead.
     let scores = values(&|p| p.fault_score);
-    if scores.iter().any(|v| v.is_finite()) {
-        let floor = scores.iter().filter(|v| v.is_finite()).all(|&v| v <= 1.0);
-        if floor {
+    let scored = scores.iter().filter(|v| v.is_finite());
+    if scored.clone().all(|&v| v <= 1.0) {
+        if scored.count() > 0 {
             figure = figure.with_note(FLAT_SCORE_NOTE);
         }
+    } else {
         let mut score = panel("envelope fault score", x);
         score.series = vec![Series {
-            label: if floor {
-                "fault score (at its floor)".into()
-            } else {
-                "strongest fault score".into()
-            },
+            label: "strongest fault score".into(),
             y: slots.y(&scores),
             color: Color::REDDISH_PURPLE,
         }];
@@ -709,6 +708,19 @@ mod tests {
                 "envelope fault score"
             ]
         );
+        // A score at its floor on every snapshot: a note, not a flat panel.
+        let flat = report(
+            (0..5)
+                .map(|i| point(i, i as f64, None, Some(1.0)))
+                .collect(),
+            vec![],
+        );
+        let figure = life_figure(&flat);
+        assert_eq!(y_labels(&figure), ["RMS (g)", "kurtosis"]);
+        assert!(figure
+            .notes
+            .iter()
+            .any(|n| n.starts_with("no fault-score panel")));
     }
 
     #[test]
