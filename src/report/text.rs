@@ -35,9 +35,16 @@ pub fn render_text(r: &AnalyzeReport) -> String {
         "  fault frequencies: BPFO {:.1} Hz, BPFI {:.1} Hz, 2xBSF {:.1} Hz, FTF {:.2} Hz, shaft {:.2} Hz",
         f.bpfo, f.bpfi, f.two_bsf, f.ftf, f.shaft
     );
+    // The header's band is the one reported (its spectrum is the one shown); a fault scored in
+    // another band says so in its row, and the header says why they differ.
+    let own_bands = if r.hypotheses.iter().any(|h| h.band_hz != r.band_hz) {
+        "; each fault below is scored in the band that shows it best"
+    } else {
+        ""
+    };
     let _ = writeln!(
         out,
-        "  band {:.0}–{:.0} Hz: {}; {} windows of {} samples",
+        "  band {:.0}–{:.0} Hz: {}; {} windows of {} samples{own_bands}",
         r.band_hz[0], r.band_hz[1], r.band_selection.reason, r.windows_averaged, r.window_samples
     );
     let _ = writeln!(

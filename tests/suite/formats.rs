@@ -279,6 +279,12 @@ fn issue16_a_2560_sample_snapshot_analyzes_with_default_options() {
         text.contains("note: bearing not given") && !text.contains("warning:"),
         "{text}"
     );
+    // The header's band (GK's, for a record with no fault) is not the one the faults are
+    // scored in here, and says so.
+    assert!(
+        text.contains("each fault below is scored in the band that shows it best"),
+        "{text}"
+    );
     let bearing3 = femto.join("Bearing3_1/acc_00001.csv");
     assert_eq!(analyze_json(&bearing3, &[])["rpm"], 1500.0);
 }
