@@ -55,23 +55,15 @@ fn foxglove_layout_and_mcap_doc_match_a_daemon_log() {
         return;
     }
     let data = scratch_dir("foxglove");
-    let out = bearingd_testdata::run_binary(
-        env!("CARGO_BIN_EXE_bearingd"),
-        &[
-            "run",
-            "--fast",
-            "--duration",
-            "60",
-            "--quiet",
-            "--data-dir",
-            data.to_str().unwrap(),
-        ],
-    );
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    crate::severity::run_ok(&[
+        "run",
+        "--fast",
+        "--duration",
+        "60",
+        "--quiet",
+        "--data-dir",
+        data.to_str().unwrap(),
+    ]);
     let logs = mcap_files(&data.join("mcap"));
     assert_eq!(logs.len(), 1, "{logs:?}");
     let layout = repo("docs/foxglove/bearingd.layout.json");
