@@ -15,7 +15,9 @@ use crate::analysis::{AnalysisError, AnalysisSettings, RecordAnalysis};
 use crate::bearing::{BearingError, BearingGeometry};
 use crate::learned::{combined as combined_with_learned, ModelError, ModelSet};
 use crate::messages::FaultKind;
-use crate::recording::{read_recording, ReadOptions, Recording, RecordingError, RecordingFormat};
+use crate::recording::{
+    read_recording, ReadOptions, Recording, RecordingError, RecordingFormat, SampleUnit,
+};
 use crate::report::{AnalyzeReport, RecordContext, SpeedSource, TwinReport};
 use crate::twin::diagnose::{combine, fit_record, TwinDiagnosis};
 use crate::twin::fit::{TwinFitter, HYPOTHESES};
@@ -213,7 +215,9 @@ pub fn demo_recording() -> Recording {
         fs_hz: Some(params.fs_hz),
         rpm: Some(params.rpm),
         samples,
-        warnings: vec![format!(
+        unit: SampleUnit::G,
+        warnings: Vec::new(),
+        notes: vec![format!(
             "simulated record: outer-race fault on {}, resonance {:.0} Hz, noise {} g, seed {}",
             params.bearing.name, params.resonance_hz, params.noise_g, params.seed
         )],
@@ -295,12 +299,8 @@ pub fn resolve_conditions(
             })
         }
     };
-    // A simulated record's "warnings" describe the simulation: they are notes.
-    let (mut notes, warnings) = if simulated {
-        (recording.warnings.clone(), Vec::new())
-    } else {
-        (Vec::new(), recording.warnings.clone())
-    };
+    let mut notes = recording.notes.clone();
+    let warnings = recording.warnings.clone();
     let bearing = match (&request.bearing, facts.bearing) {
         (Some(text), _) => BearingGeometry::parse(text)?,
         (None, Some((bearing, why))) => {
@@ -403,10 +403,10 @@ pub fn analyze_recording(
         warnings,
     };
     let mut report = AnalyzeReport::new(&context, &analysis, &request.settings);
-    // Velocity needs acceleration in physical units: a WAV file holds relative amplitudes.
-    if recording.format == RecordingFormat::Wav && !simulated {
+    // Velocity needs acceleration in physical units, not fractions of a recorder's full scale.
+    if recording.unit == SampleUnit::FullScale {
         report.notes.push(
-            "no ISO 10816-3 velocity: a WAV file holds no scale to g; export the record in g (CSV, .mat) to get it".to_string(),
+            "no ISO 10816-3 velocity: the samples are fractions of full scale, not g; give --unit g or --unit m/s2 if the recorder's full scale is known".to_string(),
         );
     } else {
         report.velocity =

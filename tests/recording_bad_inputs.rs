@@ -4,6 +4,7 @@
 
 use bearingd::recording::{
     list_channels, read_recording, ReadOptions, Recording, RecordingError, RecordingFormat,
+    SampleUnit,
 };
 use bearingd_testdata::{scratch_dir, shared_data_dir};
 use std::path::{Path, PathBuf};
@@ -12,6 +13,7 @@ fn channel(name: &str) -> ReadOptions {
     ReadOptions {
         channel: Some(name.to_string()),
         column: None,
+        unit: None,
     }
 }
 
@@ -417,6 +419,7 @@ fn csv_cut_mid_row_keeps_the_rows_before_with_a_warning() {
         &ReadOptions {
             channel: None,
             column: Some("a".into()),
+            unit: None,
         },
     )
     .unwrap();
@@ -520,6 +523,7 @@ fn unknown_missing_and_conflicting() {
     let both = ReadOptions {
         channel: Some("1".into()),
         column: Some("2".into()),
+        unit: None,
     };
     assert!(err(&path, &both).contains("give only one"));
     // A .mat-looking file without extension is found by content.
@@ -583,8 +587,9 @@ fn wav_round_trips() {
     assert_eq!(left.format, RecordingFormat::Wav);
     assert_eq!((left.channel.as_str(), left.fs_hz), ("1", Some(25_600.0)));
     assert_eq!(left.samples, [0.5, 0.0, -0.5]);
+    assert_eq!(left.unit, SampleUnit::FullScale);
     assert!(
-        left.warnings[0].contains("full-scale"),
+        left.warnings[0].contains("fractions of full scale"),
         "{:?}",
         left.warnings
     );
@@ -606,7 +611,11 @@ fn wav_round_trips() {
     assert_eq!(read(&path).unwrap().samples, [-1.0, 0.5]);
     let float = wav_bytes(1, 32, hound::SampleFormat::Float, &[1, -2, 12]);
     let path = write(&dir, "f32.wav", &with_list_chunk(&float));
-    assert_eq!(read(&path).unwrap().samples, [0.125, -0.25, 1.5]);
+    let float = read(&path).unwrap();
+    assert_eq!(float.samples, [0.125, -0.25, 1.5]);
+    assert_eq!(float.unit, SampleUnit::G);
+    assert!(float.warnings.is_empty(), "{:?}", float.warnings);
+    assert!(float.notes[0].contains("taken as g"), "{:?}", float.notes);
 }
 
 #[test]

@@ -10,6 +10,7 @@ fn channel(name: &str) -> ReadOptions {
     ReadOptions {
         channel: Some(name.to_string()),
         column: None,
+        unit: None,
     }
 }
 

@@ -42,6 +42,7 @@ fuzz_target!(|data: &[u8]| {
     let options = ReadOptions {
         channel: CHANNELS[usize::from(*channel) % CHANNELS.len()].map(str::to_string),
         column: None,
+        unit: None,
     };
     with_budget(budget(name, content.len()), || {
         if let Err(e) = read_recording_from_bytes(path, content, &options) {

@@ -6,7 +6,7 @@
 
 use super::{CliError, RecordingArgs};
 use crate::offline::{resolve_conditions, AnalyzeRequest};
-use crate::recording::read_recording;
+use crate::recording::{read_recording, SampleUnit};
 use crate::sinks::mcap::raw_log::{import_recording, Import, LogSignal, RawLogError};
 use clap::Args;
 use std::path::PathBuf;
@@ -40,6 +40,9 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     }
     for warning in &conditions.warnings {
         eprintln!("bearingd: import: warning: {warning}");
+    }
+    if recording.unit == SampleUnit::FullScale {
+        eprintln!("bearingd: import: warning: the log states its samples in g, so these fractions of full scale will be read as g (thresholds, velocity); give --unit g or --unit m/s2 if the recorder's full scale is known");
     }
     let fs = conditions.fs_hz;
     let imported = import_recording(&Import {

@@ -42,13 +42,36 @@ pub struct RecordingArgs {
     /// rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0".
     #[arg(long)]
     pub bearing: Option<String>,
+    /// Unit of the file's values, for WAV, plain CSV and .mat files (default: g; for an
+    /// integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no
+    /// velocity in mm/s.
+    #[arg(long, value_enum)]
+    pub unit: Option<UnitArg>,
+}
+
+/// The values `--unit` takes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum UnitArg {
+    /// Acceleration in g.
+    G,
+    /// Acceleration in m/s².
+    #[value(name = "m/s2")]
+    MetresPerSecondSquared,
+    /// Relative amplitudes (fractions of a recorder's full scale).
+    FullScale,
 }
 
 impl RecordingArgs {
     pub fn read_options(&self) -> crate::recording::ReadOptions {
+        use crate::recording::StatedUnit;
         crate::recording::ReadOptions {
             channel: self.channel.clone(),
             column: self.column.clone(),
+            unit: self.unit.map(|unit| match unit {
+                UnitArg::G => StatedUnit::G,
+                UnitArg::MetresPerSecondSquared => StatedUnit::MetresPerSecondSquared,
+                UnitArg::FullScale => StatedUnit::FullScale,
+            }),
         }
     }
 }
@@ -102,7 +125,8 @@ enum Command {
     /// through the real pipeline: detection probability, false alarms, confusion matrix, plot.
     /// Runs in bearingd-lab.
     Evaluate(lab::LabArgs),
-    /// Follow a bearing's life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs):
+    /// Follow a bearing's life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs; WAV
+    /// and CSV with --interval):
     /// health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its
     /// time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab.
     Trend(lab::LabArgs),

@@ -16,7 +16,7 @@
 //! Coupling: only [`crate::mcap_log::read_messages`], [`crate::mcap_log::read_header`] and the
 //! message types; the log reader may move (the module "house"), this file should not need to.
 
-use super::{Recording, RecordingError, RecordingFormat};
+use super::{Recording, RecordingError, RecordingFormat, SampleUnit};
 use crate::mcap_log::{read_header, read_messages, LoggedMessage};
 use crate::messages::PipelineMessage;
 use std::collections::BTreeSet;
@@ -351,6 +351,8 @@ pub fn read_log(
         rpm,
         samples: j.samples,
         warnings,
+        unit: SampleUnit::G,
+        notes: Vec::new(),
     };
     Ok((recording, placement))
 }

@@ -8,8 +8,9 @@ mod mcap;
 pub use mcap::{LogPlacement, LoggedHwFit, Segment};
 
 pub use bearing_signal::recording::{
-    detect_format, time_from_name, LogReader, NamedTime, NamedTimeKind, ReadOptions, Recording,
-    RecordingError, RecordingFormat, MCAP_MAGIC, PRONOSTIA_PERIOD_S,
+    detect_format, ixml_track_names, time_from_name, LogReader, NamedTime, NamedTimeKind,
+    ReadOptions, Recording, RecordingError, RecordingFormat, SampleUnit, StatedUnit, MCAP_MAGIC,
+    PRONOSTIA_PERIOD_S,
 };
 
 use std::cell::RefCell;

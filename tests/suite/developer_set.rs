@@ -110,6 +110,7 @@ fn every_ims_channel_is_healthy() {
                 read: ReadOptions {
                     channel: Some(channel.into()),
                     column: None,
+                    unit: None,
                 },
                 ..Default::default()
             };

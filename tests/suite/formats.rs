@@ -331,3 +331,154 @@ fn issue16_a_table_with_several_columns_names_the_column_option() {
         assert!(err.contains(needle), "'{needle}' missing: {err}");
     }
 }
+
+/// The velocity RMS (mm/s) of a report, which must have one.
+fn velocity_mm_s(report: &Value) -> f64 {
+    report["velocity"]["rms_mm_s"]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no velocity: {report:#}"))
+}
+
+fn notes_of(report: &Value) -> String {
+    format!("{} {}", report["notes"], report["warnings"])
+}
+
+/// A 16-bit PCM WAV of `samples` scaled so that `full_scale` is ±32768 counts, written with
+/// hound (the recorder's counts: a file that states no unit).
+fn write_pcm16(path: &Path, samples: &[f64], full_scale: f64, fs: u32) {
+    let spec = hound::WavSpec {
+        channels: 1,
+        sample_rate: fs,
+        bits_per_sample: 16,
+        sample_format: hound::SampleFormat::Int,
+    };
+    let mut w = hound::WavWriter::create(path, spec).unwrap();
+    for s in samples {
+        w.write_sample((s / full_scale * 32768.0).round().clamp(-32768.0, 32767.0) as i16)
+            .unwrap();
+    }
+    w.finalize().unwrap();
+}
+
+#[test]
+fn issue33_what_simulate_writes_as_wav_is_read_in_g_with_its_channel_name() {
+    let dir = scratch_dir("formats-wav-units");
+    let (wav, csv) = (dir.join("sim.wav"), dir.join("sim.csv"));
+    simulate(&wav, "skf-6205-2rs", 1772.0, 12_000.0, 4.0);
+    simulate(&csv, "skf-6205-2rs", 1772.0, 12_000.0, 4.0);
+    let given = ["--rpm", "1772", "--bearing", "skf-6205-2rs"];
+    let from_wav = analyze_json(&wav, &given);
+    let from_csv = analyze_json(&csv, &[&given[..], &["--fs", "12000"]].concat());
+
+    // The same values, the same unit, the same channel name as the CSV column.
+    assert_eq!(from_wav["channel"], "accel_g");
+    assert_eq!(from_csv["channel"], "accel_g");
+    let (v_wav, v_csv) = (velocity_mm_s(&from_wav), velocity_mm_s(&from_csv));
+    assert!(
+        (v_wav - v_csv).abs() <= 1e-6 * v_csv,
+        "WAV {v_wav} mm/s, CSV {v_csv} mm/s"
+    );
+    assert!(
+        notes_of(&from_wav).contains("float WAV samples taken as g"),
+        "{}",
+        notes_of(&from_wav)
+    );
+    // The channel by its name or its number.
+    for channel in ["accel_g", "ACCEL_G", "1"] {
+        let report = analyze_json(&wav, &[&given[..], &["--channel", channel]].concat());
+        assert_eq!(report["channel"], "accel_g", "--channel {channel}");
+    }
+
+    // --unit restates the values: m/s² are divided by standard gravity, full scale has no
+    // velocity, and the format's own assumption is replaced, not kept beside.
+    let in_ms2 = analyze_json(&wav, &[&given[..], &["--unit", "m/s2"]].concat());
+    let ratio = v_wav / velocity_mm_s(&in_ms2);
+    assert!((ratio - 9.80665).abs() < 1e-6, "ratio {ratio}");
+    let notes = notes_of(&in_ms2);
+    assert!(notes.contains("divided by 9.80665"), "{notes}");
+    assert!(!notes.contains("taken as g"), "{notes}");
+    let relative = analyze_json(&wav, &[&given[..], &["--unit", "full-scale"]].concat());
+    assert!(relative["velocity"].is_null(), "{relative:#}");
+    assert!(
+        notes_of(&relative).contains("no ISO 10816-3 velocity"),
+        "{}",
+        notes_of(&relative)
+    );
+    // The diagnosis does not depend on the unit.
+    for report in [&from_wav, &in_ms2, &relative] {
+        assert_outer_race(report);
+    }
+}
+
+#[test]
+fn issue33_an_integer_wav_is_relative_until_its_unit_is_stated() {
+    let dir = scratch_dir("formats-wav-int");
+    let (csv, wav) = (dir.join("sim.csv"), dir.join("recorder.wav"));
+    simulate(&csv, "skf-6205-2rs", 1772.0, 12_000.0, 4.0);
+    let samples = read_samples(&csv);
+    let full_scale = samples.iter().fold(0.0f64, |m, s| m.max(s.abs())) * 1.25;
+    write_pcm16(&wav, &samples, full_scale, 12_000);
+    let given = ["--rpm", "1772", "--bearing", "skf-6205-2rs"];
+
+    let relative = analyze_json(&wav, &given);
+    assert_eq!(relative["channel"], "1", "no iXML chunk: numbered");
+    assert!(relative["velocity"].is_null(), "{relative:#}");
+    assert!(
+        notes_of(&relative).contains("fractions of full scale"),
+        "{}",
+        notes_of(&relative)
+    );
+    assert_outer_race(&relative);
+
+    // Stated in g: ±1.0 full scale is 1 g, so the velocity is the CSV's over the full scale.
+    let csv_v = velocity_mm_s(&analyze_json(
+        &csv,
+        &[&given[..], &["--fs", "12000"]].concat(),
+    ));
+    let stated = analyze_json(&wav, &[&given[..], &["--unit", "g"]].concat());
+    let expected = csv_v / full_scale;
+    let got = velocity_mm_s(&stated);
+    assert!(
+        (got - expected).abs() < 0.01 * expected,
+        "{got} mm/s, expected {expected} (16-bit rounding aside)"
+    );
+    assert!(
+        notes_of(&stated).contains("--unit g"),
+        "{}",
+        notes_of(&stated)
+    );
+    assert!(!notes_of(&stated).contains("fractions of full scale"));
+
+    // import says what it does with relative values.
+    let out = bearingd(&[
+        "import",
+        wav.to_str().unwrap(),
+        "--out",
+        dir.join("imported").to_str().unwrap(),
+        "--rpm",
+        "1772",
+        "--bearing",
+        "skf-6205-2rs",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("will be read as g"), "{err}");
+}
+
+#[test]
+fn issue33_unit_is_refused_where_the_data_set_documents_it_and_choices_are_listed() {
+    let dir = scratch_dir("formats-unit-refused");
+    let snapshot = dir.join("acc_00001.csv");
+    write_pronostia(&snapshot, &vec![0.1; 2560]);
+    let err = analyze_error(&snapshot, &["--unit", "m/s2"]);
+    assert!(
+        err.contains("--unit does not apply") && err.contains("PRONOSTIA"),
+        "{err}"
+    );
+    // clap's own error lists the same choices the help does.
+    let out = bearingd(&["analyze", "--demo", "--unit", "volts"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    for choice in ["g", "m/s2", "full-scale"] {
+        assert!(err.contains(choice), "'{choice}' missing: {err}");
+    }
+}

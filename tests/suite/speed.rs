@@ -39,6 +39,7 @@ fn cwru_drive_end_speed_estimated_from_three_per_cent_off_within_half_a_per_cent
             &ReadOptions {
                 channel: Some(row["channel_var"].clone()),
                 column: None,
+                unit: None,
             },
         )
         .unwrap();

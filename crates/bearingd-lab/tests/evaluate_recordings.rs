@@ -258,6 +258,7 @@ fn a_two_and_a_half_second_record_that_analyze_names_is_flagged_by_the_daemon() 
         let options = bearingd::recording::ReadOptions {
             channel: Some("DE".to_string()),
             column: None,
+            unit: None,
         };
         let full = bearingd::recording::read_recording(&cwru.join(record), &options).unwrap();
         let name = record.replace(".mat", "_2.5s.csv");

@@ -492,3 +492,90 @@ fn a_log_of_a_daemon_with_hw_on_is_never_identified_again() {
     assert!(points.iter().all(|p| p["hw_from"].is_null()), "{report}");
     assert!(note_with(&report, "hold no HW fit").is_none(), "{report}");
 }
+
+/// Issue 33 item 4: a folder of what `simulate` writes as WAV trends in g, its channel named,
+/// with the same RMS as the same record written as CSV; an integer WAV is said to be relative.
+#[test]
+fn simulated_wavs_trend_in_g_and_integer_wavs_are_said_to_be_relative() {
+    let dir = scratch_dir("trend-wav-units");
+    let (wavs, csvs) = (dir.join("wav"), dir.join("csv"));
+    for (folder, ext) in [(&wavs, "wav"), (&csvs, "csv")] {
+        std::fs::create_dir_all(folder).unwrap();
+        for k in 1..=3 {
+            let out = folder.join(format!("snapshot{k}.{ext}"));
+            let made = lab(&[
+                "simulate",
+                "--fault",
+                "outer",
+                "--rpm",
+                "1772",
+                "--duration",
+                "1s",
+                "--out",
+                out.to_str().unwrap(),
+            ]);
+            assert!(made.status.success(), "{}", stderr(&made));
+        }
+    }
+    // Their names state no time: without --interval the WAVs are skipped, each named.
+    let out = lab(&["trend", wavs.to_str().unwrap(), "--rpm", "1772"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("snapshot1.wav") && stderr(&out).contains("--interval"),
+        "{}",
+        stderr(&out)
+    );
+    let given = [
+        "--baseline",
+        "2",
+        "--window",
+        "1",
+        "--no-hw",
+        "--rpm",
+        "1772",
+        "--bearing",
+        "skf-6205-2rs",
+        "--interval",
+        "60",
+    ];
+    let from_wav = trend_json(&wavs, &given);
+    let from_csv = trend_json(&csvs, &[&given[..], &["--fs", "12000"]].concat());
+    assert_eq!(from_wav["channel"], "accel_g");
+    let notes = from_wav["notes"].to_string();
+    assert!(notes.contains("float WAV samples taken as g"), "{notes}");
+    assert!(!notes.contains("full scale, not g"), "{notes}");
+    let rms = |report: &Value| -> Vec<f64> {
+        let points = report["points"].as_array().unwrap();
+        points.iter().map(|p| p["rms"].as_f64().unwrap()).collect()
+    };
+    let (rms_wav, rms_csv) = (rms(&from_wav), rms(&from_csv));
+    assert_eq!(rms_wav.len(), 3);
+    assert_eq!(rms_wav.len(), rms_csv.len());
+    for (w, c) in rms_wav.iter().zip(&rms_csv) {
+        assert!((w - c).abs() <= 1e-6 * c, "WAV RMS {w} g, CSV {c} g");
+    }
+
+    // The same folder as 16-bit counts: relative, and the note says what does not apply.
+    let ints = dir.join("int");
+    std::fs::create_dir_all(&ints).unwrap();
+    for k in 1..=3 {
+        let mut reader = hound::WavReader::open(wavs.join(format!("snapshot{k}.wav"))).unwrap();
+        let spec = hound::WavSpec {
+            bits_per_sample: 16,
+            sample_format: hound::SampleFormat::Int,
+            ..reader.spec()
+        };
+        let mut w = hound::WavWriter::create(ints.join(format!("snapshot{k}.wav")), spec).unwrap();
+        for s in reader.samples::<f32>() {
+            w.write_sample((s.unwrap() * 3000.0) as i16).unwrap();
+        }
+        w.finalize().unwrap();
+    }
+    let relative = trend_json(&ints, &given);
+    let notes = relative["notes"].to_string();
+    assert!(notes.contains("fractions of full scale, not g"), "{notes}");
+    assert!(
+        notes.contains("failure threshold in g does not apply"),
+        "{notes}"
+    );
+}

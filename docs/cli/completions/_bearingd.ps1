@@ -40,7 +40,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('train', 'train', [CompletionResultType]::ParameterValue, 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab')
             [CompletionResult]::new('calibrate', 'calibrate', [CompletionResultType]::ParameterValue, 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab')
             [CompletionResult]::new('evaluate', 'evaluate', [CompletionResultType]::ParameterValue, 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot. Runs in bearingd-lab')
-            [CompletionResult]::new('trend', 'trend', [CompletionResultType]::ParameterValue, 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab')
+            [CompletionResult]::new('trend', 'trend', [CompletionResultType]::ParameterValue, 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs; WAV and CSV with --interval): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab')
             [CompletionResult]::new('help', 'help', [CompletionResultType]::ParameterValue, 'Print this message or the help of the given subcommand(s)')
             break
         }
@@ -50,6 +50,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate in Hz (overrides what the file says)')
             [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed in rpm (overrides what the file says)')
             [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
+            [CompletionResult]::new('--unit', '--unit', [CompletionResultType]::ParameterName, 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s')
             [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--plot', '--plot', [CompletionResultType]::ParameterName, 'Draw the envelope spectrum and the kurtogram to this file (.png or .svg); with several records, the record''s file name is added before the extension. Runs in bearingd-lab')
             [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'Take the analysis settings from this configuration file''s [analysis] section, and its twin.learned_model unless --learned is given: the daemon''s decision, offline')
@@ -86,9 +87,10 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate in Hz (overrides what the file says)')
             [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed in rpm (overrides what the file says)')
             [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
+            [CompletionResult]::new('--unit', '--unit', [CompletionResultType]::ParameterName, 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s')
             [CompletionResult]::new('--sensor', '--sensor', [CompletionResultType]::ParameterName, 'Sensor id in the log')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;replay' {
@@ -181,7 +183,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0"')
             [CompletionResult]::new('--duration', '--duration', [CompletionResultType]::ParameterName, 'Length of the record: seconds, e.g. 10 or 10s')
             [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate, Hz')
-            [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Output file: .csv (one column, g) or .wav (32-bit float, g)')
+            [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Output file: .csv (one column, accel_g, in g) or .wav (32-bit float in g; an iXML chunk names its channel accel_g)')
             [CompletionResult]::new('--load', '--load', [CompletionResultType]::ParameterName, 'Physics model: radial load, N')
             [CompletionResult]::new('--defect-width', '--defect-width', [CompletionResultType]::ParameterName, 'Physics model: defect width, mm (CWRU: 0.178, 0.356, 0.533)')
             [CompletionResult]::new('--damping-ratio', '--damping-ratio', [CompletionResultType]::ParameterName, 'Physics model: damping ratio of the resonator (its resonance is --resonance)')
@@ -228,6 +230,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate in Hz (overrides what the file says)')
             [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed in rpm (overrides what the file says)')
             [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
+            [CompletionResult]::new('--unit', '--unit', [CompletionResultType]::ParameterName, 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s')
             [CompletionResult]::new('--fault', '--fault', [CompletionResultType]::ParameterName, 'The defect to model; default: the envelope diagnosis of the record')
             [CompletionResult]::new('--band', '--band', [CompletionResultType]::ParameterName, 'The band compared, as LO-HI in Hz; default: the band the envelope analysis chose for the fault')
             [CompletionResult]::new('--load', '--load', [CompletionResultType]::ParameterName, 'Radial load on the bearing, N')
@@ -263,6 +266,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--fs', '--fs', [CompletionResultType]::ParameterName, 'Sample rate in Hz (overrides what the file says)')
             [CompletionResult]::new('--rpm', '--rpm', [CompletionResultType]::ParameterName, 'Shaft speed in rpm (overrides what the file says)')
             [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
+            [CompletionResult]::new('--unit', '--unit', [CompletionResultType]::ParameterName, 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s')
             [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--plot', '--plot', [CompletionResultType]::ParameterName, 'Draw the stage timeline (RMS with the trend, kurtosis, HW residual, fault score) to this file (.png or .svg)')
             [CompletionResult]::new('--baseline', '--baseline', [CompletionResultType]::ParameterName, 'Snapshots that form the healthy baseline (and the aging baseline of RMS)')
@@ -270,7 +274,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--sigma', '--sigma', [CompletionResultType]::ParameterName, 'Standard deviations above a baseline that change the stage')
             [CompletionResult]::new('--trend-window', '--trend-window', [CompletionResultType]::ParameterName, 'Snapshots in the sliding window of the RMS trend')
             [CompletionResult]::new('--threshold-g', '--threshold-g', [CompletionResultType]::ParameterName, 'RMS threshold in g for the time-to-threshold (default: the failure limit the tracker learns at the start of degradation)')
-            [CompletionResult]::new('--interval', '--interval', [CompletionResultType]::ParameterName, 'Seconds between snapshots whose names state no time (e.g. other .mcap files), placed in name order')
+            [CompletionResult]::new('--interval', '--interval', [CompletionResultType]::ParameterName, 'Seconds between snapshots whose names state no time (.mcap and .wav files; given this, any other file too, e.g. CSV tables), placed in name order')
             [CompletionResult]::new('--window', '--window', [CompletionResultType]::ParameterName, 'Records longer than 1.5 windows (IMS, MCAP logs) are cut into windows of this many seconds, each one snapshot')
             [CompletionResult]::new('--no-hw', '--no-hw', [CompletionResultType]::ParameterName, 'Do not identify the HW model per snapshot')
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
@@ -293,7 +297,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('train', 'train', [CompletionResultType]::ParameterValue, 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab')
             [CompletionResult]::new('calibrate', 'calibrate', [CompletionResultType]::ParameterValue, 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab')
             [CompletionResult]::new('evaluate', 'evaluate', [CompletionResultType]::ParameterValue, 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot. Runs in bearingd-lab')
-            [CompletionResult]::new('trend', 'trend', [CompletionResultType]::ParameterValue, 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab')
+            [CompletionResult]::new('trend', 'trend', [CompletionResultType]::ParameterValue, 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs; WAV and CSV with --interval): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab')
             [CompletionResult]::new('help', 'help', [CompletionResultType]::ParameterValue, 'Print this message or the help of the given subcommand(s)')
             break
         }

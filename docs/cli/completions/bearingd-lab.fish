@@ -31,7 +31,7 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "dataset" 
 complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "train" -d 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`'
 complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "calibrate" -d 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra'
 complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "evaluate" -d 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot; or real recordings of a manifest through `analyze` and through the daemon'
-complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "trend" -d 'Follow a bearing\'s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot'
+complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "trend" -d 'Follow a bearing\'s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs; WAV and CSV with --interval): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot'
 complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "analyze" -d 'Diagnose a recording as `bearingd analyze` does, and draw the envelope spectrum and the kurtogram with --plot (`bearingd analyze --plot` runs this)'
 complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "completions" -d 'Print the shell completion script of bearingd-lab (or, with --program bearingd, of the service) for bash, zsh, fish, elvish or powershell; with --out DIR write them all'
 complete -c bearingd-lab -n "__fish_bearingd_lab_needs_command" -f -a "man" -d 'Write the man pages of bearingd and bearingd-lab and of each of their commands into a directory (`make install` installs the committed ones, docs/cli/man)'
@@ -47,7 +47,7 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0"' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l duration -d 'Length of the record: seconds, e.g. 10 or 10s' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l fs -d 'Sample rate, Hz' -r
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l out -d 'Output file: .csv (one column, g) or .wav (32-bit float, g)' -r -F
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l out -d 'Output file: .csv (one column, accel_g, in g) or .wav (32-bit float in g; an iXML chunk names its channel accel_g)' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l load -d 'Physics model: radial load, N' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l defect-width -d 'Physics model: defect width, mm (CWRU: 0.178, 0.356, 0.533)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l damping-ratio -d 'Physics model: damping ratio of the resonator (its resonance is --resonance)' -r
@@ -86,6 +86,9 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l 
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l fs -d 'Sample rate in Hz (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l rpm -d 'Shaft speed in rpm (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l unit -d 'Unit of the file\'s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s' -r -f -a "g\t'Acceleration in g'
+m/s2\t'Acceleration in m/s²'
+full-scale\t'Relative amplitudes (fractions of a recorder\'s full scale)'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l fault -d 'The defect to model; default: the envelope diagnosis of the record' -r -f -a "none\t''
 outer\t''
 inner\t''
@@ -118,6 +121,9 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l colu
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l fs -d 'Sample rate in Hz (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l rpm -d 'Shaft speed in rpm (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l unit -d 'Unit of the file\'s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s' -r -f -a "g\t'Acceleration in g'
+m/s2\t'Acceleration in m/s²'
+full-scale\t'Relative amplitudes (fractions of a recorder\'s full scale)'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l format -d 'Output format' -r -f -a "text\t'The stage timeline and the trend, for people'
 json\t'Everything, per snapshot, as one JSON document'
 table\t'One Markdown table row per snapshot'"
@@ -127,7 +133,7 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l smoo
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l sigma -d 'Standard deviations above a baseline that change the stage' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l trend-window -d 'Snapshots in the sliding window of the RMS trend' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l threshold-g -d 'RMS threshold in g for the time-to-threshold (default: the failure limit the tracker learns at the start of degradation)' -r
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l interval -d 'Seconds between snapshots whose names state no time (e.g. other .mcap files), placed in name order' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l interval -d 'Seconds between snapshots whose names state no time (.mcap and .wav files; given this, any other file too, e.g. CSV tables), placed in name order' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l window -d 'Records longer than 1.5 windows (IMS, MCAP logs) are cut into windows of this many seconds, each one snapshot' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l no-hw -d 'Do not identify the HW model per snapshot'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -s h -l help -d 'Print help (see more with \'--help\')'
@@ -136,6 +142,9 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l co
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l fs -d 'Sample rate in Hz (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l rpm -d 'Shaft speed in rpm (overrides what the file says)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l bearing -d 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l unit -d 'Unit of the file\'s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s' -r -f -a "g\t'Acceleration in g'
+m/s2\t'Acceleration in m/s²'
+full-scale\t'Relative amplitudes (fractions of a recorder\'s full scale)'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l format -d 'Output format' -r -f -a "text\t'A few lines per record for people'
 json\t'One JSON document per record (a JSON array for several records)'
 table\t'One Markdown table row per record, for comparing many records'"
@@ -168,7 +177,7 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not 
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not __fish_seen_subcommand_from simulate dataset train calibrate evaluate trend analyze completions man help" -f -a "train" -d 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not __fish_seen_subcommand_from simulate dataset train calibrate evaluate trend analyze completions man help" -f -a "calibrate" -d 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not __fish_seen_subcommand_from simulate dataset train calibrate evaluate trend analyze completions man help" -f -a "evaluate" -d 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot; or real recordings of a manifest through `analyze` and through the daemon'
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not __fish_seen_subcommand_from simulate dataset train calibrate evaluate trend analyze completions man help" -f -a "trend" -d 'Follow a bearing\'s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot'
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not __fish_seen_subcommand_from simulate dataset train calibrate evaluate trend analyze completions man help" -f -a "trend" -d 'Follow a bearing\'s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs; WAV and CSV with --interval): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not __fish_seen_subcommand_from simulate dataset train calibrate evaluate trend analyze completions man help" -f -a "analyze" -d 'Diagnose a recording as `bearingd analyze` does, and draw the envelope spectrum and the kurtogram with --plot (`bearingd analyze --plot` runs this)'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not __fish_seen_subcommand_from simulate dataset train calibrate evaluate trend analyze completions man help" -f -a "completions" -d 'Print the shell completion script of bearingd-lab (or, with --program bearingd, of the service) for bash, zsh, fish, elvish or powershell; with --out DIR write them all'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand help; and not __fish_seen_subcommand_from simulate dataset train calibrate evaluate trend analyze completions man help" -f -a "man" -d 'Write the man pages of bearingd and bearingd-lab and of each of their commands into a directory (`make install` installs the committed ones, docs/cli/man)'

@@ -37,7 +37,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand train 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab'
             cand calibrate 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab'
             cand evaluate 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot. Runs in bearingd-lab'
-            cand trend 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab'
+            cand trend 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs; WAV and CSV with --interval): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab'
             cand help 'Print this message or the help of the given subcommand(s)'
         }
         &'bearingd;analyze'= {
@@ -46,6 +46,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --fs 'Sample rate in Hz (overrides what the file says)'
             cand --rpm 'Shaft speed in rpm (overrides what the file says)'
             cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
+            cand --unit 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s'
             cand --format 'Output format'
             cand --plot 'Draw the envelope spectrum and the kurtogram to this file (.png or .svg); with several records, the record''s file name is added before the extension. Runs in bearingd-lab'
             cand --config 'Take the analysis settings from this configuration file''s [analysis] section, and its twin.learned_model unless --learned is given: the daemon''s decision, offline'
@@ -80,9 +81,10 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --fs 'Sample rate in Hz (overrides what the file says)'
             cand --rpm 'Shaft speed in rpm (overrides what the file says)'
             cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
+            cand --unit 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s'
             cand --sensor 'Sensor id in the log'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;replay'= {
             cand --config 'Analyse with this configuration instead of the one the log was recorded with (needed for logs without it: older files, `bearingd import`)'
@@ -163,7 +165,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=9,d=7.94mm,D=39.04mm,alpha=0"'
             cand --duration 'Length of the record: seconds, e.g. 10 or 10s'
             cand --fs 'Sample rate, Hz'
-            cand --out 'Output file: .csv (one column, g) or .wav (32-bit float, g)'
+            cand --out 'Output file: .csv (one column, accel_g, in g) or .wav (32-bit float in g; an iXML chunk names its channel accel_g)'
             cand --load 'Physics model: radial load, N'
             cand --defect-width 'Physics model: defect width, mm (CWRU: 0.178, 0.356, 0.533)'
             cand --damping-ratio 'Physics model: damping ratio of the resonator (its resonance is --resonance)'
@@ -207,6 +209,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --fs 'Sample rate in Hz (overrides what the file says)'
             cand --rpm 'Shaft speed in rpm (overrides what the file says)'
             cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
+            cand --unit 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s'
             cand --fault 'The defect to model; default: the envelope diagnosis of the record'
             cand --band 'The band compared, as LO-HI in Hz; default: the band the envelope analysis chose for the fault'
             cand --load 'Radial load on the bearing, N'
@@ -240,6 +243,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --fs 'Sample rate in Hz (overrides what the file says)'
             cand --rpm 'Shaft speed in rpm (overrides what the file says)'
             cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
+            cand --unit 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s'
             cand --format 'Output format'
             cand --plot 'Draw the stage timeline (RMS with the trend, kurtosis, HW residual, fault score) to this file (.png or .svg)'
             cand --baseline 'Snapshots that form the healthy baseline (and the aging baseline of RMS)'
@@ -247,7 +251,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --sigma 'Standard deviations above a baseline that change the stage'
             cand --trend-window 'Snapshots in the sliding window of the RMS trend'
             cand --threshold-g 'RMS threshold in g for the time-to-threshold (default: the failure limit the tracker learns at the start of degradation)'
-            cand --interval 'Seconds between snapshots whose names state no time (e.g. other .mcap files), placed in name order'
+            cand --interval 'Seconds between snapshots whose names state no time (.mcap and .wav files; given this, any other file too, e.g. CSV tables), placed in name order'
             cand --window 'Records longer than 1.5 windows (IMS, MCAP logs) are cut into windows of this many seconds, each one snapshot'
             cand --no-hw 'Do not identify the HW model per snapshot'
             cand -h 'Print help (see more with ''--help'')'
@@ -269,7 +273,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand train 'Train the learned diagnosis (denoising autoencoder + 1-D CNN) on a data set of `bearingd dataset`; writes a model file for `analyze --learned`. Runs in bearingd-lab'
             cand calibrate 'Fit the physics twin (resonator stiffness and damping, contact stiffness, defect width) to a measured record; prints the parameters and the fit error, plots the spectra. Runs in bearingd-lab'
             cand evaluate 'Sweep simulated faults (type × severity × SNR × speed × bearing, and healthy records) through the real pipeline: detection probability, false alarms, confusion matrix, plot. Runs in bearingd-lab'
-            cand trend 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab'
+            cand trend 'Follow a bearing''s life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs; WAV and CSV with --interval): health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its time to the failure limit; text, JSON or a table, and a plot. Runs in bearingd-lab'
             cand help 'Print this message or the help of the given subcommand(s)'
         }
         &'bearingd;help;analyze'= {

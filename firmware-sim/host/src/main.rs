@@ -11,7 +11,7 @@
 mod pacing;
 mod transport;
 
-use bearing_signal::recording::{read_recording, ReadOptions};
+use bearing_signal::recording::{read_recording, ReadOptions, SampleUnit};
 use bearing_signal::simulate::{SimulatedFault, SimulationParams, Simulator};
 use bearing_wire::{
     encode, AxisSet, FirmwareVersion, FrameKind, NodeConfig, SensorNode, SpeedSource,
@@ -369,9 +369,16 @@ fn open_signal(args: &Args) -> Result<(Signal, u32, f64), SimError> {
             &ReadOptions {
                 channel: args.channel.clone(),
                 column: None,
+                unit: None,
             },
         )
         .map_err(|e| SimError::Input(e.to_string()))?;
+        if recording.unit == SampleUnit::FullScale {
+            eprintln!(
+                "firmware-sim: warning: {}: the samples are fractions of full scale, not g; they are sent as if g",
+                path.display()
+            );
+        }
         let fs = match (args.fs, recording.fs_hz) {
             (Some(fs), _) => fs,
             (None, Some(fs)) => fs.round() as u32,

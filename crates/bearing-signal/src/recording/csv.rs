@@ -63,6 +63,8 @@ pub(super) fn read_pronostia(
         rpm: None,
         samples: column.samples,
         warnings: column.warnings,
+        unit: super::SampleUnit::G,
+        notes: Vec::new(),
     })
 }
 
@@ -83,6 +85,8 @@ pub(super) fn read_plain(
         rpm: None,
         samples: column.samples,
         warnings: column.warnings,
+        unit: super::SampleUnit::G,
+        notes: Vec::new(),
     })
 }
 

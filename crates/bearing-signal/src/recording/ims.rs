@@ -70,6 +70,8 @@ pub(super) fn read(
         rpm: None,
         samples: column.samples,
         warnings: column.warnings,
+        unit: super::SampleUnit::G,
+        notes: Vec::new(),
     })
 }
 

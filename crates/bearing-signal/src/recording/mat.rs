@@ -442,6 +442,8 @@ pub(super) fn read(
         rpm,
         samples,
         warnings,
+        unit: super::SampleUnit::G,
+        notes: Vec::new(),
     })
 }
 

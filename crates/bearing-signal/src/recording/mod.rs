@@ -25,6 +25,7 @@ mod text;
 mod wav;
 
 pub use snapshot_time::{time_from_name, NamedTime, NamedTimeKind, PRONOSTIA_PERIOD_S};
+pub use wav::ixml_track_names;
 
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -45,12 +46,51 @@ pub struct Recording {
     /// Shaft speed, when the file states it (the CWRU `XNNNRPM` variable, a MATLAB `rpm` or
     /// `rate` scalar, an MCAP log's speed topic); `None` otherwise.
     pub rpm: Option<f64>,
-    /// The samples, all finite: acceleration in g for the data-set formats; for WAV, full-scale
-    /// units (see [`RecordingFormat::Wav`]).
+    /// The samples, all finite, in [`Recording::unit`].
     pub samples: Vec<f64>,
-    /// Things the caller should show the user, e.g. a dropped incomplete last row.
+    /// What the samples are in: g for the data sets, logs, tables and float WAVs; fractions of
+    /// full scale for an integer WAV (unless the user stated its unit).
+    pub unit: SampleUnit,
+    /// Things the caller should show the user as wrong or doubtful, e.g. a dropped incomplete
+    /// last row.
     pub warnings: Vec<String>,
+    /// What was assumed about the file and why, e.g. that a float WAV holds g: information.
+    pub notes: Vec<String>,
 }
+
+/// What a recording's sample values are in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampleUnit {
+    /// Acceleration in g: what velocity severity and the daemon's thresholds need.
+    G,
+    /// Fractions of the recorder's full scale (an integer WAV): amplitudes are relative, so
+    /// spectra and scores hold but no velocity in mm/s can be computed.
+    FullScale,
+}
+
+impl fmt::Display for SampleUnit {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            SampleUnit::G => "g",
+            SampleUnit::FullScale => "full scale",
+        })
+    }
+}
+
+/// The unit a user states for a file's values (`--unit`), for the formats that do not document
+/// theirs: WAV, plain CSV tables and MATLAB files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StatedUnit {
+    /// The values are g (for an integer WAV: ±1.0 full scale is ±1 g).
+    G,
+    /// The values are m/s²; they are divided by standard gravity to give g.
+    MetresPerSecondSquared,
+    /// The values are relative: no velocity is computed from them.
+    FullScale,
+}
+
+/// Standard gravity (m/s² per g), ISO 80000-3.
+pub const STANDARD_GRAVITY: f64 = 9.80665;
 
 /// The file formats this module reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -71,9 +111,11 @@ pub enum RecordingFormat {
     /// A `.csv`, `.tsv` or `.txt` table of numbers, with or without a header row; separator
     /// `;`, tab, `,` or spaces. The sampling rate is unknown.
     PlainCsv,
-    /// WAV, integer or float samples. Integers are scaled to ±1.0 full scale, floats are kept
-    /// as they are; the file holds no scale to g, so the amplitudes are relative (a warning
-    /// says so).
+    /// WAV, integer or float samples. Floats are read as the values they hold, taken as g (what
+    /// `bearingd simulate` writes; a note says so); integers are scaled to ±1.0 full scale,
+    /// relative amplitudes (a warning says so). `--unit` states otherwise. Channels are named
+    /// by the file's iXML chunk (`TRACK_LIST`, as field recorders and `bearingd simulate` write
+    /// it), else numbered from 1.
     Wav,
     /// An MCAP log written by `bearingd run` (or `import`): the raw blocks of one channel
     /// (`sensor/axis`), in g, at the rate the blocks carry; the shaft speed from its speed or
@@ -101,11 +143,13 @@ impl fmt::Display for RecordingFormat {
 pub struct ReadOptions {
     /// CWRU: `DE`, `FE`, `BA` or a variable name. Other MATLAB files: a variable or a field
     /// path (`bearing.gs`, `s(2).x`, `c{1}`). PRONOSTIA: `horizontal` or `vertical`. IMS:
-    /// `B1x` … `B4y` or `1` … `8`. CSV: a header name or a 1-based index. WAV: `1`, `2`, …
+    /// `B1x` … `B4y` or `1` … `8`. CSV: a header name or a 1-based index. WAV: an iXML track name or `1`, `2`, …
     /// MCAP log: `sensor/axis`.
     pub channel: Option<String>,
     /// Synonym of `channel`, for tables.
     pub column: Option<String>,
+    /// The unit of the values, when the user states it; `None` keeps the format's own.
+    pub unit: Option<StatedUnit>,
 }
 
 /// Why a file could not be read. Each message is one line naming the file.
@@ -190,6 +234,12 @@ pub enum RecordingError {
         path: PathBuf,
         channels: Vec<String>,
     },
+    #[error("{path}: --unit does not apply: a {format} file is in g by {why}; --unit is for WAV, plain CSV and .mat files, whose unit is not documented")]
+    UnitDocumented {
+        path: PathBuf,
+        format: RecordingFormat,
+        why: &'static str,
+    },
     #[error("{path}: channel '{channel}' and column '{column}' name different channels; give only one of them")]
     ConflictingSelection {
         path: PathBuf,
@@ -263,12 +313,12 @@ pub fn read_recording_with(
     let selector = selector(path, options)?;
     if is_log(path)? {
         // A log can be large: it is read message by message, one channel kept.
-        let recording = logs.read(path, selector)?;
+        let recording = with_stated_unit(logs.read(path, selector)?, options.unit)?;
         check_finite(&recording)?;
         return Ok(recording);
     }
     let bytes = read_file(path)?;
-    decode_recording(path, &bytes, selector, logs)
+    decode_recording(path, &bytes, selector, options.unit, logs)
 }
 
 /// Reads one channel of a recording from bytes already in memory; `path` only names the file
@@ -282,14 +332,15 @@ pub fn read_recording_from_bytes(
 ) -> Result<Recording, RecordingError> {
     let selector = selector(path, options)?;
     check_not_empty(path, bytes)?;
-    decode_recording(path, bytes, selector, &NoLogs)
+    decode_recording(path, bytes, selector, options.unit, &NoLogs)
 }
 
-/// The decoder [`detect_format`] picks, then the finiteness check.
+/// The decoder [`detect_format`] picks, the unit the user stated, then the finiteness check.
 fn decode_recording(
     path: &Path,
     bytes: &[u8],
     selector: Option<&str>,
+    unit: Option<StatedUnit>,
     logs: &dyn LogReader,
 ) -> Result<Recording, RecordingError> {
     let recording = match detect_format(path, bytes)? {
@@ -300,6 +351,7 @@ fn decode_recording(
         RecordingFormat::Wav => wav::read(path, bytes, selector)?,
         RecordingFormat::McapLog => logs.read(path, selector)?,
     };
+    let recording = with_stated_unit(recording, unit)?;
     check_finite(&recording)?;
     Ok(recording)
 }
@@ -475,6 +527,60 @@ fn file_name(path: &Path) -> String {
 
 /// Refuses an empty recording or one with NaN or infinite samples (the text readers check
 /// earlier, to name the line).
+/// The recording in the unit the user stated (`--unit`), said in a note; refused for the
+/// formats whose unit is documented (the data sets' files and bearingd's logs are in g).
+fn with_stated_unit(
+    mut recording: Recording,
+    stated: Option<StatedUnit>,
+) -> Result<Recording, RecordingError> {
+    let Some(stated) = stated else {
+        return Ok(recording);
+    };
+    let documented = match recording.format {
+        RecordingFormat::PronostiaCsv | RecordingFormat::ImsText => {
+            Some("its data set's documentation")
+        }
+        RecordingFormat::McapLog => Some("bearingd's log format"),
+        RecordingFormat::Matlab | RecordingFormat::PlainCsv | RecordingFormat::Wav => None,
+    };
+    if let Some(why) = documented {
+        return Err(RecordingError::UnitDocumented {
+            path: recording.path,
+            format: recording.format,
+            why,
+        });
+    }
+    // The format's own assumption about the unit no longer holds: its note goes.
+    recording.notes.retain(|n| !n.starts_with(UNIT_NOTE_PREFIX));
+    recording
+        .warnings
+        .retain(|w| !w.starts_with(UNIT_NOTE_PREFIX));
+    let note = match stated {
+        StatedUnit::G => {
+            recording.unit = SampleUnit::G;
+            "values taken as g, as --unit g says".to_string()
+        }
+        StatedUnit::MetresPerSecondSquared => {
+            recording.unit = SampleUnit::G;
+            for s in &mut recording.samples {
+                *s /= STANDARD_GRAVITY;
+            }
+            format!("values in m/s², as --unit m/s2 says: divided by {STANDARD_GRAVITY} to give g")
+        }
+        StatedUnit::FullScale => {
+            recording.unit = SampleUnit::FullScale;
+            "values taken as relative (full scale), as --unit full-scale says: no velocity in mm/s"
+                .to_string()
+        }
+    };
+    recording.notes.push(format!("{UNIT_NOTE_PREFIX}{note}"));
+    Ok(recording)
+}
+
+/// How every note or warning about a recording's unit starts, so a stated unit can replace the
+/// format's assumption.
+pub const UNIT_NOTE_PREFIX: &str = "unit: ";
+
 fn check_finite(recording: &Recording) -> Result<(), RecordingError> {
     if recording.samples.is_empty() {
         return Err(RecordingError::Empty {
@@ -542,6 +648,7 @@ mod tests {
         let options = ReadOptions {
             channel: Some("y".to_string()),
             column: None,
+            unit: None,
         };
         let from_file = read_recording(&path, &options).unwrap();
         let from_bytes = read_recording_from_bytes(&path, text, &options).unwrap();

@@ -44,7 +44,8 @@ enum Command {
     /// through the real pipeline: detection probability, false alarms, confusion matrix, plot;
     /// or real recordings of a manifest through `analyze` and through the daemon.
     Evaluate(evaluate::EvaluateArgs),
-    /// Follow a bearing's life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs):
+    /// Follow a bearing's life through a directory of snapshots (PRONOSTIA, IMS, MCAP logs; WAV
+    /// and CSV with --interval):
     /// health stages, RMS, kurtosis, HW residual, fault score, the RMS trend and its
     /// time to the failure limit; text, JSON or a table, and a plot.
     Trend(trend::TrendArgs),

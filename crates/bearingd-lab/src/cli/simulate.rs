@@ -42,7 +42,8 @@ pub struct SimulateArgs {
     /// Sample rate, Hz.
     #[arg(long, default_value_t = 12_000.0)]
     fs: f64,
-    /// Output file: .csv (one column, g) or .wav (32-bit float, g).
+    /// Output file: .csv (one column, accel_g, in g) or .wav (32-bit float in g; an iXML chunk
+    /// names its channel accel_g).
     #[arg(long)]
     out: PathBuf,
     /// Physics model: radial load, N.
@@ -311,12 +312,35 @@ fn write_wav(path: &PathBuf, fs: f64, samples: &[f32]) -> std::io::Result<()> {
     for &s in samples {
         writer.write_sample(s).map_err(std::io::Error::other)?;
     }
-    writer.finalize().map_err(std::io::Error::other)
+    writer.finalize().map_err(std::io::Error::other)?;
+    name_the_channel(path)
 }
+
+/// Appends an iXML chunk naming the one channel as the CSV column is named (`accel_g`), and
+/// grows the RIFF size to hold it: readers that honour iXML (ours, field-recorder software)
+/// show the name, the others skip the chunk.
+fn name_the_channel(path: &PathBuf) -> std::io::Result<()> {
+    use std::io::{Seek, SeekFrom};
+    let chunk = bearingd::recording::ixml_track_names(&[CHANNEL_NAME]);
+    let mut file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .open(path)?;
+    let end = file.seek(SeekFrom::End(0))?;
+    file.write_all(&chunk)?;
+    let riff_size = u32::try_from(end + chunk.len() as u64 - 8)
+        .map_err(|_| std::io::Error::other("the WAV file exceeds 4 GiB"))?;
+    file.seek(SeekFrom::Start(4))?;
+    file.write_all(&riff_size.to_le_bytes())?;
+    file.sync_all()
+}
+
+/// The name of the simulated channel in both output formats: acceleration in g.
+const CHANNEL_NAME: &str = "accel_g";
 
 fn write_csv(path: &PathBuf, samples: &[f32]) -> std::io::Result<()> {
     let mut out = std::io::BufWriter::new(std::fs::File::create(path)?);
-    writeln!(out, "accel_g")?;
+    writeln!(out, "{CHANNEL_NAME}")?;
     for s in samples {
         writeln!(out, "{s}")?;
     }

@@ -12,7 +12,9 @@ use crate::analysis::health::CONFIRM_WINDOWS;
 use crate::evaluate::recordings::Manifest;
 use crate::life::{hindsight, HwFrom, LifeSettings, LifeTracker, SnapshotHw};
 use crate::offline::{resolve_conditions, AnalyzeRequest, OfflineError};
-use crate::recording::{read_recording_placed, time_from_name, LogPlacement, LoggedHwFit, Segment};
+use crate::recording::{
+    read_recording_placed, time_from_name, LogPlacement, LoggedHwFit, SampleUnit, Segment,
+};
 use crate::report::{
     life_figure, render_life_text, LifeGap, LifeReport, LifeSettingsReport, SkippedFile,
 };
@@ -65,8 +67,8 @@ pub struct TrendArgs {
     /// learns at the start of degradation).
     #[arg(long)]
     threshold_g: Option<f64>,
-    /// Seconds between snapshots whose names state no time (e.g. other .mcap files), placed in
-    /// name order.
+    /// Seconds between snapshots whose names state no time (.mcap and .wav files; given this,
+    /// any other file too, e.g. CSV tables), placed in name order.
     #[arg(long)]
     interval: Option<f64>,
     /// Records longer than 1.5 windows (IMS, MCAP logs) are cut into windows of this many
@@ -154,6 +156,7 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
                 (c.fs_hz, Some(c.bearing.fault_frequencies(c.rpm / 60.0)))
             }
             Err(OfflineError::UnknownSpeed { .. } | OfflineError::UnknownBearing { .. }) => {
+                notes.extend(recording.notes.iter().cloned());
                 notes.extend(recording.warnings.iter().cloned());
                 notes.insert("no shaft speed or bearing known for some snapshots: no envelope fault score for them; give --rpm (and --bearing) to score the fault bands".into());
                 match args.recording.fs.or(recording.fs_hz) {
@@ -176,6 +179,9 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
                 continue;
             }
         };
+        if recording.unit == SampleUnit::FullScale {
+            notes.insert("some snapshots are in fractions of full scale, not g: their RMS is relative and the failure threshold in g does not apply to them; give --unit g or --unit m/s2 if the recorder's full scale is known".into());
+        }
         channel.get_or_insert_with(|| recording.channel.clone());
         let window = ((args.window * fs_hz).round() as usize).max(1);
         let pieces = cut(&recording.samples, placement.as_ref(), window, fs_hz);
@@ -214,7 +220,7 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
             message.push_str(&format!("\n  {}", s.error));
         }
         if skipped.is_empty() {
-            message.push_str("; give a directory of PRONOSTIA acc_NNNNN.csv files, IMS files named like 2003.10.22.12.14.13, or bearingd MCAP logs");
+            message.push_str("; give a directory of PRONOSTIA acc_NNNNN.csv files, IMS files named like 2003.10.22.12.14.13, or bearingd MCAP logs; other recordings (WAV, CSV tables) with --interval SECONDS");
         }
         return Err(CliError::input(message));
     }
@@ -664,7 +670,12 @@ fn list_snapshots(args: &TrendArgs) -> Result<Listing, CliError> {
                 seconds: t.seconds,
                 sequence: 0,
             });
-        } else if is_mcap(&file) || path.is_file() {
+        } else if is_mcap(&file) || has_extension(&file, "wav") || path.is_file() {
+            // Recordings whose name states no time: placed by --interval or skipped, named.
+            unplaced.push(file);
+        } else if args.interval.is_some() {
+            // Given an interval, any file is a snapshot in name order (CSV tables included);
+            // one that does not read is skipped with its reason.
             unplaced.push(file);
         } else {
             ignored.push(file_label(&file));
@@ -695,7 +706,7 @@ fn list_snapshots(args: &TrendArgs) -> Result<Listing, CliError> {
         None => skipped.extend(unplaced.into_iter().map(|f| SkippedFile {
             file: file_label(&f),
             error: format!(
-                "{}: its name states no time (bearingd logs are named bearingd-YYYYMMDDTHHMMSSZ-NNNNNN.mcap); give --interval SECONDS to place such files in name order",
+                "{}: its name states no time (bearingd logs are named bearingd-YYYYMMDDTHHMMSSZ-NNNNNN.mcap, IMS snapshots YYYY.MM.DD.hh.mm.ss, PRONOSTIA ones acc_NNNNN.csv); give --interval SECONDS to place such files in name order",
                 f.display()
             ),
         })),
@@ -728,8 +739,12 @@ fn log_anchor(path: &Path) -> Option<(f64, u64)> {
 }
 
 fn is_mcap(path: &Path) -> bool {
+    has_extension(path, "mcap")
+}
+
+fn has_extension(path: &Path, extension: &str) -> bool {
     path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("mcap"))
+        .is_some_and(|e| e.eq_ignore_ascii_case(extension))
 }
 
 fn file_label(path: &Path) -> String {

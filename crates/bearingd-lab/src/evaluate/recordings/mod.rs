@@ -351,6 +351,7 @@ pub fn evaluate_task(
     let read = ReadOptions {
         channel: task.channel.clone(),
         column: None,
+        unit: None,
     };
     let recording = match read_recording(file, &read) {
         Ok(recording) => recording,
