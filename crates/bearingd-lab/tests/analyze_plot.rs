@@ -80,7 +80,8 @@ fn issue16_analyze_reports_velocity_rms_and_zone_of_an_analytic_sine() {
     );
     let svg = std::fs::read_to_string(&plot).unwrap();
     assert!(
-        svg.contains("velocity RMS per bin (mm/s)"),
+        // The y title is wrapped onto two lines.
+        svg.contains("velocity RMS per") && svg.contains("bin (mm/s)"),
         "no velocity panel"
     );
     assert!(svg.contains("zone D"), "the plot does not show the zone");

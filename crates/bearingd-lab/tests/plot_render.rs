@@ -136,6 +136,7 @@ fn kurtogram_panel() -> HeatmapPanel {
         rows,
         highlight: Some((2, 1)),
         value_label: "GK index".into(),
+        y_label: "level".into(),
     }
 }
 
@@ -195,9 +196,9 @@ fn png_decodes_with_expected_size_and_drawn_plot() {
     let figure = diagnosis_figure();
     let bytes = plot::render_png(&figure).unwrap();
     let (width, height) = png_dimensions(&bytes);
-    assert_eq!(width, 1200);
+    assert_eq!(width, 1600);
     assert!(
-        height > 2 * 380 && height < 2 * 380 + 300,
+        height > 2 * 480 && height < 2 * 480 + 300,
         "height {height}"
     );
     let pixmap = Pixmap::decode_png(&bytes).unwrap();
@@ -210,7 +211,7 @@ fn png_decodes_with_expected_size_and_drawn_plot() {
         .enumerate()
         .filter(|(i, _)| {
             let (x, y) = ((*i as u32) % width, (*i as u32) / width);
-            (150..1100).contains(&x) && (150..400).contains(&y)
+            (200..1500).contains(&x) && (200..500).contains(&y)
         })
         .filter(|(_, p)| p.blue() > 120 && p.red() < 80)
         .count();
@@ -255,7 +256,7 @@ fn single_sample_spike_survives_decimation() {
         .max()
         .expect("series drawn");
     let (top_x, top_y) = *series_pixels.iter().min_by_key(|&&(_, y)| y).unwrap();
-    let (plot_left, plot_right) = (96.0, 1200.0 - 32.0);
+    let (plot_left, plot_right) = (176.0, 1600.0 - 40.0);
     let expected_x = plot_left + spike as f64 / n as f64 * (plot_right - plot_left);
     assert!(
         (f64::from(top_x) - expected_x).abs() < 2.0,
@@ -340,6 +341,7 @@ fn hostile_inputs_do_not_panic() {
         ],
         highlight: Some((7, 9)),
         value_label: String::new(),
+        y_label: String::new(),
     };
     let no_rows = HeatmapPanel {
         rows: vec![],

@@ -119,6 +119,9 @@ pub struct SpectrumPanel {
     pub x_range: Option<(f64, f64)>,
     /// Logarithmic y axis; zeros and negatives sit on the axis floor.
     pub log_y: bool,
+    /// Horizontal reference lines (e.g. zone boundaries), labelled at the right end.
+    #[serde(default)]
+    pub levels: Vec<Level>,
 }
 
 impl SpectrumPanel {
@@ -133,6 +136,7 @@ impl SpectrumPanel {
             shaded: Vec::new(),
             x_range: None,
             log_y: false,
+            levels: Vec::new(),
         }
     }
 }
@@ -149,6 +153,16 @@ pub struct Series {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Marker {
     pub x: f64,
+    pub label: String,
+    pub color: Color,
+    pub dashed: bool,
+}
+
+/// A horizontal line at `y` across a spectrum panel, labelled at its right end; the y axis
+/// is extended to show it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Level {
+    pub y: f64,
     pub label: String,
     pub color: Color,
     pub dashed: bool,
@@ -175,6 +189,9 @@ pub struct HeatmapPanel {
     pub highlight: Option<(usize, usize)>,
     /// What the colours mean, e.g. "GK index"; written by the colour bar.
     pub value_label: String,
+    /// Title of the y axis (what a row is); empty for none.
+    #[serde(default)]
+    pub y_label: String,
 }
 
 /// One row of a heatmap: a label (e.g. the level "1.6") and cell values left to right.

@@ -8,7 +8,8 @@
 //! How: a [`Figure`] is plain data describing what to show. One layout pass
 //! (`scene`, using the axis maths in [`layout`]) turns it into pixel-space primitives; two thin
 //! renderers write those as SVG markup or rasterise them with tiny-skia into a PNG. Text in the
-//! PNG comes from a built-in public-domain 8×8 bitmap font, so rendering works on a headless
+//! PNG comes from a built-in public-domain 8×8 bitmap font, drawn at 2× (16 px body text, 24 px
+//! titles) so that it reads on a normal screen, so rendering works on a headless
 //! edge box with no fonts, no fontconfig and no display.
 //!
 //! Ours stays, not `plotters`: its PNG text needs system fonts (font-kit) or a font file, and
@@ -37,7 +38,7 @@ mod svg;
 use std::path::{Path, PathBuf};
 
 pub use figure::{
-    Color, Figure, HeatmapPanel, HeatmapRow, Marker, Panel, Series, Shade, SpectrumPanel,
+    Color, Figure, HeatmapPanel, HeatmapRow, Level, Marker, Panel, Series, Shade, SpectrumPanel,
 };
 
 /// File extensions [`save`] understands, lower case and without the dot.

@@ -4,7 +4,9 @@
 use crate::analysis::iso::VelocitySeverity;
 use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::messages::FaultKind;
-use crate::plot::{Color, Figure, HeatmapPanel, HeatmapRow, Marker, Series, Shade, SpectrumPanel};
+use crate::plot::{
+    Color, Figure, HeatmapPanel, HeatmapRow, Level, Marker, Series, Shade, SpectrumPanel,
+};
 use crate::twin::diagnose::TwinDiagnosis;
 use bearingd::report::AnalyzeReport;
 
@@ -41,41 +43,14 @@ pub fn analysis_figure(
     });
     panel.log_y = true;
     panel.x_range = Some((0.0, x_max));
-    let tolerance = report.thresholds.fault_tolerance;
-    let diagnosed = analysis.diagnosis.verdict.fault();
-    for kind in [FaultKind::OuterRace, FaultKind::InnerRace, FaultKind::Ball] {
-        let f = kind.frequency(&analysis.frequencies);
-        let color = fault_color(kind);
-        for order in 1..=report.thresholds.harmonics {
-            let at = order as f64 * f;
-            if at > x_max {
-                break;
-            }
-            let label = if order == 1 {
-                kind.frequency_label().to_string()
-            } else {
-                format!("{} x{order}", kind.frequency_label())
-            };
-            panel.markers.push(Marker {
-                x: at,
-                label,
-                color,
-                dashed: diagnosed != Some(kind),
-            });
-            panel.shaded.push(Shade {
-                x0: at * (1.0 - tolerance),
-                x1: at * (1.0 + tolerance),
-                color: color.with_alpha(40),
-            });
-        }
-    }
     let shaft = analysis.frequencies.shaft;
-    panel.markers.push(Marker {
-        x: shaft,
-        label: "1x shaft".into(),
-        color: Color::GREY,
-        dashed: true,
-    });
+    fault_markers(
+        &mut panel,
+        analysis,
+        report.thresholds.harmonics,
+        report.thresholds.fault_tolerance,
+        x_max,
+    );
 
     let use_gk = matches!(report_selection(report), Some(BandSelection::GiniKurtosis));
     let mut rows = Vec::new();
@@ -119,6 +94,7 @@ pub fn analysis_figure(
         } else {
             "kurtosis".into()
         },
+        y_label: "level k: Δf=fs/2^(k+1)".into(),
     };
 
     let figure = Figure::new(format!("{} [{}]", report.file, report.channel))
@@ -152,6 +128,67 @@ pub fn analysis_figure(
     figure.with_panel(heatmap)
 }
 
+/// Marks every harmonic of each fault frequency up to `x_max`, and the shaft frequency. The
+/// harmonics the diagnosis scores (orders up to `scored`) get their tolerance band shaded and
+/// a full-strength line; the others a paler line. Fundamentals come first so that their
+/// labels win a crowded spot (the scene drops labels that would collide; the lines stay).
+fn fault_markers(
+    panel: &mut SpectrumPanel,
+    analysis: &RecordAnalysis,
+    scored: usize,
+    tolerance: f64,
+    x_max: f64,
+) {
+    /// A guard against a fault frequency so low that its harmonics would fill the axis.
+    const MAX_ORDER: usize = 200;
+    let diagnosed = analysis.diagnosis.verdict.fault();
+    let kinds = [FaultKind::OuterRace, FaultKind::InnerRace, FaultKind::Ball];
+    panel.markers.push(Marker {
+        x: analysis.frequencies.shaft,
+        label: "1x shaft".into(),
+        color: Color::GREY,
+        dashed: true,
+    });
+    for order in 1..=MAX_ORDER {
+        let mut any = false;
+        for kind in kinds {
+            let f = kind.frequency(&analysis.frequencies);
+            let at = order as f64 * f;
+            if !(f > 0.0 && at.is_finite() && at <= x_max) {
+                continue;
+            }
+            any = true;
+            let color = fault_color(kind);
+            let label = if order == 1 {
+                kind.frequency_label().to_string()
+            } else {
+                format!("{} x{order}", kind.frequency_label())
+            };
+            let is_scored = order <= scored;
+            panel.markers.push(Marker {
+                x: at,
+                label,
+                color: if is_scored {
+                    color
+                } else {
+                    color.with_alpha(110)
+                },
+                dashed: diagnosed != Some(kind),
+            });
+            if is_scored {
+                panel.shaded.push(Shade {
+                    x0: at * (1.0 - tolerance),
+                    x1: at * (1.0 + tolerance),
+                    color: color.with_alpha(40),
+                });
+            }
+        }
+        if !any {
+            break;
+        }
+    }
+}
+
 /// The velocity spectrum the ISO 10816-3 value sums (RMS per bin, in the standard's band),
 /// with the shaft harmonics marked: where the velocity comes from (unbalance at 1x,
 /// misalignment at 2x, or broadband).
@@ -175,6 +212,27 @@ fn velocity_panel(v: &VelocitySeverity, shaft_hz: f64) -> SpectrumPanel {
         x0: v.band_hz[0],
         x1: v.band_hz[1],
         color: Color::GREY.with_alpha(25),
+    });
+    // The zone boundaries apply to the overall RMS (the root of the sum over the bins): the
+    // overall value is drawn with them, and one bin alone reaching a line reaches that zone.
+    let l = &v.limits;
+    for (y, name, color) in [
+        (l.ab_mm_s, "A/B", Color::BLUISH_GREEN),
+        (l.bc_mm_s, "B/C", Color::ORANGE),
+        (l.cd_mm_s, "C/D", Color::VERMILLION),
+    ] {
+        panel.levels.push(Level {
+            y,
+            label: format!("ISO zone {name} {y} mm/s"),
+            color,
+            dashed: true,
+        });
+    }
+    panel.levels.push(Level {
+        y: v.rms_mm_s,
+        label: format!("overall {:.2} mm/s RMS", v.rms_mm_s),
+        color: Color::BLUE,
+        dashed: false,
     });
     for order in 1..=3 {
         let at = order as f64 * shaft_hz;

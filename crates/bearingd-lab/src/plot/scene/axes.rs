@@ -2,8 +2,8 @@
 //! and the axis titles.
 
 use super::TEXT_SCALE;
-use super::{crisp, fit_text, text, text_width, Anchor, Item, PlotArea, Stroke, Text};
-use super::{FRAME_COLOR, GLYPH_SIZE, GRID_COLOR, LINE_HEIGHT, OUTER_PAD, PLOT_LEFT, TEXT_COLOR};
+use super::{crisp, fit_text, text, text_width, wrap_text, Anchor, Item, PlotArea, Stroke, Text};
+use super::{FRAME_COLOR, GRID_COLOR, LINE_HEIGHT, OUTER_PAD, PLOT_LEFT, TEXT_COLOR, TEXT_HEIGHT};
 use crate::plot::layout::{PixelScale, Tick};
 
 pub(super) fn grid(
@@ -48,6 +48,9 @@ pub(super) fn frame(items: &mut Vec<Item>, area: &PlotArea) {
 }
 
 pub(super) const TICK_LENGTH: f64 = 5.0;
+
+/// Room for a y tick label: the plot's left margin less the two-line y title and gaps.
+pub(super) const Y_TICK_LABEL_WIDTH: f64 = PLOT_LEFT - 2.0 * OUTER_PAD - 2.0 * TEXT_HEIGHT - 20.0;
 
 pub(super) fn tick_labels_x(
     items: &mut Vec<Item>,
@@ -97,8 +100,8 @@ pub(super) fn tick_labels_y(
         });
         items.push(text(
             area.left - TICK_LENGTH - 4.0,
-            py - GLYPH_SIZE / 2.0,
-            fit_text(&tick.label, TEXT_SCALE, PLOT_LEFT - 36.0),
+            py - TEXT_HEIGHT / 2.0,
+            fit_text(&tick.label, TEXT_SCALE, Y_TICK_LABEL_WIDTH),
             TEXT_SCALE,
             Anchor::End,
             TEXT_COLOR,
@@ -117,11 +120,22 @@ pub(super) fn axis_titles(items: &mut Vec<Item>, area: &PlotArea, x_label: &str,
             TEXT_COLOR,
         ));
     }
-    if !y_label.is_empty() {
+    // The y title reads bottom to top, wrapped onto at most two lines beside each other.
+    let lines = wrap_text(y_label, TEXT_SCALE, area.height());
+    let shown = lines.len().min(2);
+    for (i, line) in lines.iter().take(shown).enumerate() {
+        let line = if i + 1 == shown && lines.len() > shown {
+            fit_text(&lines[i..].join(" "), TEXT_SCALE, area.height())
+        } else {
+            line.clone()
+        };
+        if line.is_empty() {
+            continue;
+        }
         items.push(Item::Text(Text {
-            x: OUTER_PAD,
+            x: OUTER_PAD + i as f64 * (TEXT_HEIGHT + 4.0),
             y: (area.top + area.bottom) / 2.0,
-            content: fit_text(y_label, TEXT_SCALE, area.height()),
+            content: line,
             scale: TEXT_SCALE,
             anchor: Anchor::Middle,
             color: TEXT_COLOR,

@@ -1,9 +1,11 @@
 //! A heatmap panel (rows of band values, e.g. the kurtogram): cells merged when there are
 //! more than pixels, the chosen cell outlined with its caption, and the colour bar.
 
-use super::axes::{axis_titles, frame, tick_labels_x, TICK_LENGTH};
+use super::axes::{axis_titles, frame, tick_labels_x, TICK_LENGTH, Y_TICK_LABEL_WIDTH};
 use super::{crisp, fit_text, text, text_width, Anchor, Item, PlotArea, Stroke, Text};
-use super::{FIGURE_WIDTH, GLYPH_SIZE, LINE_HEIGHT, PANEL_HEIGHT, PLOT_LEFT, PLOT_RIGHT_PAD};
+use super::{
+    BELOW_PLOT, FIGURE_WIDTH, LINE_HEIGHT, PANEL_HEIGHT, PLOT_LEFT, PLOT_RIGHT_PAD, TEXT_HEIGHT,
+};
 use super::{FRAME_COLOR, TEXT_COLOR, TEXT_SCALE};
 use crate::plot::figure::{Color, HeatmapPanel};
 use crate::plot::layout::{finite_range, format_number, Axis, PixelScale};
@@ -11,7 +13,7 @@ use crate::plot::layout::{finite_range, format_number, Axis, PixelScale};
 /// Heatmap cells narrower than this many pixels are merged (showing the column maximum).
 const MIN_CELL_WIDTH: f64 = 1.0;
 /// Space right of a heatmap for the colour bar, its ticks and its label.
-const COLOR_BAR_AREA: f64 = 120.0;
+const COLOR_BAR_AREA: f64 = 170.0;
 const COLOR_BAR_WIDTH: f64 = 18.0;
 const COLOR_BAR_STEPS: usize = 96;
 const MISSING_CELL: Color = Color::rgb(200, 200, 200);
@@ -76,7 +78,7 @@ pub(super) fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item
         left: PLOT_LEFT,
         right: FIGURE_WIDTH - PLOT_RIGHT_PAD - COLOR_BAR_AREA,
         top: top + 4.0 + LINE_HEIGHT + 10.0,
-        bottom: (top + PANEL_HEIGHT - 52.0).round(),
+        bottom: (top + PANEL_HEIGHT - BELOW_PLOT).round(),
     };
     let x_max = if panel.x_max.is_finite() && panel.x_max > 0.0 {
         panel.x_max
@@ -126,7 +128,7 @@ pub(super) fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item
         });
         items.push(text(
             (area.left + area.right) / 2.0,
-            (area.top + area.bottom) / 2.0 - GLYPH_SIZE / 2.0,
+            (area.top + area.bottom) / 2.0 - TEXT_HEIGHT / 2.0,
             String::from("no data"),
             TEXT_SCALE,
             Anchor::Middle,
@@ -173,8 +175,8 @@ pub(super) fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item
         let centre = (row_edge(r) + row_edge(r + 1)) / 2.0;
         items.push(text(
             area.left - 6.0,
-            centre - GLYPH_SIZE / 2.0,
-            fit_text(&row.label, TEXT_SCALE, PLOT_LEFT - 24.0),
+            centre - TEXT_HEIGHT / 2.0,
+            fit_text(&row.label, TEXT_SCALE, Y_TICK_LABEL_WIDTH),
             TEXT_SCALE,
             Anchor::End,
             TEXT_COLOR,
@@ -235,7 +237,7 @@ pub(super) fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item
     frame(items, &area);
     let x_ticks = x_scale.axis.ticks(((area.width() / 90.0) as usize).max(2));
     tick_labels_x(items, &area, &x_scale, &x_ticks);
-    axis_titles(items, &area, &panel.x_label, "");
+    axis_titles(items, &area, &panel.x_label, &panel.y_label);
     color_bar(items, &area, value_axis, &panel.value_label);
 }
 
@@ -282,7 +284,7 @@ fn color_bar(items: &mut Vec<Item>, area: &PlotArea, values: Axis, label: &str) 
         widest = widest.max(text_width(&tick.label, TEXT_SCALE));
         items.push(text(
             bar.right + TICK_LENGTH + 4.0,
-            py - GLYPH_SIZE / 2.0,
+            py - TEXT_HEIGHT / 2.0,
             tick.label,
             TEXT_SCALE,
             Anchor::Start,
@@ -291,7 +293,7 @@ fn color_bar(items: &mut Vec<Item>, area: &PlotArea, values: Axis, label: &str) 
     }
     if !label.is_empty() {
         items.push(Item::Text(Text {
-            x: (bar.right + TICK_LENGTH + 4.0 + widest + 8.0).min(FIGURE_WIDTH - GLYPH_SIZE - 4.0),
+            x: (bar.right + TICK_LENGTH + 4.0 + widest + 8.0).min(FIGURE_WIDTH - TEXT_HEIGHT - 4.0),
             y: (bar.top + bar.bottom) / 2.0,
             content: fit_text(label, TEXT_SCALE, bar.height()),
             scale: TEXT_SCALE,

@@ -20,22 +20,27 @@ use spectrum::spectrum_panel;
 pub(crate) const GLYPH_SIZE: f64 = 8.0;
 
 /// Figure width in pixels.
-const FIGURE_WIDTH: f64 = 1200.0;
+const FIGURE_WIDTH: f64 = 1600.0;
 /// Height of one panel in pixels.
-const PANEL_HEIGHT: f64 = 380.0;
+const PANEL_HEIGHT: f64 = 480.0;
 /// More panels than this would make an unreasonably tall image.
 pub(crate) const MAX_PANELS: usize = 16;
 /// Notes beyond this many lines are summarised as "… n more".
 const MAX_NOTE_LINES: usize = 12;
 
 const OUTER_PAD: f64 = 16.0;
-const PLOT_LEFT: f64 = 96.0;
-const PLOT_RIGHT_PAD: f64 = 32.0;
-const LINE_HEIGHT: f64 = 14.0;
-const TITLE_SCALE: u32 = 2;
-const TEXT_SCALE: u32 = 1;
+const PLOT_LEFT: f64 = 176.0;
+const PLOT_RIGHT_PAD: f64 = 40.0;
+const LINE_HEIGHT: f64 = 22.0;
+const TITLE_SCALE: u32 = 3;
+const TEXT_SCALE: u32 = 2;
+/// Height (and glyph advance) of body text in pixels.
+const TEXT_HEIGHT: f64 = GLYPH_SIZE * TEXT_SCALE as f64;
 
 const TEXT_COLOR: Color = Color::rgb(30, 30, 30);
+/// Space below a panel's plot for the tick labels and the x axis title.
+const BELOW_PLOT: f64 = 72.0;
+
 const MUTED_TEXT: Color = Color::rgb(80, 80, 80);
 const FRAME_COLOR: Color = Color::rgb(60, 60, 60);
 const GRID_COLOR: Color = Color::rgb(228, 228, 228);
@@ -196,41 +201,63 @@ fn text(x: f64, y: f64, content: String, scale: u32, anchor: Anchor, color: Colo
     })
 }
 
-/// Title and notes; returns the y where panels start.
+/// `text` broken at spaces into lines of at most `max_width` pixels at `scale`; a word longer
+/// than a line is cut into pieces. Nothing is dropped.
+pub(super) fn wrap_text(text: &str, scale: u32, max_width: f64) -> Vec<String> {
+    let capacity = ((max_width / (GLYPH_SIZE * f64::from(scale))).floor() as usize).max(1);
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in text.split(' ').filter(|w| !w.is_empty()) {
+        let chars: Vec<char> = word.chars().collect();
+        for piece in chars.chunks(capacity) {
+            let needed = line.chars().count() + usize::from(!line.is_empty()) + piece.len();
+            let piece: String = piece.iter().collect();
+            if !line.is_empty() && needed > capacity {
+                lines.push(std::mem::take(&mut line));
+            }
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            line.push_str(&piece);
+        }
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
+/// Title and notes, wrapped to the figure's width; returns the y where panels start.
 fn header(figure: &Figure, items: &mut Vec<Item>) -> f64 {
     let max_width = FIGURE_WIDTH - 2.0 * OUTER_PAD;
     let mut y = OUTER_PAD;
-    items.push(text(
-        OUTER_PAD,
-        y,
-        fit_text(&figure.title, TITLE_SCALE, max_width),
-        TITLE_SCALE,
-        Anchor::Start,
-        TEXT_COLOR,
-    ));
-    y += GLYPH_SIZE * f64::from(TITLE_SCALE) + 10.0;
-    let shown = if figure.notes.len() > MAX_NOTE_LINES {
-        MAX_NOTE_LINES - 1
-    } else {
-        figure.notes.len()
-    };
-    for note in &figure.notes[..shown] {
+    for line in wrap_text(&figure.title, TITLE_SCALE, max_width) {
         items.push(text(
             OUTER_PAD,
             y,
-            fit_text(note, TEXT_SCALE, max_width),
-            TEXT_SCALE,
+            line,
+            TITLE_SCALE,
             Anchor::Start,
-            MUTED_TEXT,
+            TEXT_COLOR,
         ));
-        y += LINE_HEIGHT;
+        y += GLYPH_SIZE * f64::from(TITLE_SCALE) + 6.0;
     }
-    if shown < figure.notes.len() {
-        let more = format!("... {} more", figure.notes.len() - shown);
+    y += 6.0;
+    let mut lines: Vec<String> = figure
+        .notes
+        .iter()
+        .flat_map(|note| wrap_text(note, TEXT_SCALE, max_width))
+        .collect();
+    if lines.len() > MAX_NOTE_LINES {
+        let more = lines.len() - (MAX_NOTE_LINES - 1);
+        lines.truncate(MAX_NOTE_LINES - 1);
+        lines.push(format!("... {more} more lines"));
+    }
+    for line in lines {
         items.push(text(
             OUTER_PAD,
             y,
-            more,
+            line,
             TEXT_SCALE,
             Anchor::Start,
             MUTED_TEXT,
@@ -267,5 +294,12 @@ mod tests {
         assert_eq!(fit_text("abcdefgh", 1, 48.0), "abc...");
         assert_eq!(fit_text("abc", 1, 48.0), "abc");
         assert_eq!(fit_text("abc", 1, 0.0), "");
+    }
+
+    #[test]
+    fn text_is_wrapped_at_spaces_without_loss() {
+        assert_eq!(wrap_text("ab cd ef", 1, 40.0), ["ab cd", "ef"]);
+        assert_eq!(wrap_text("abcdefgh", 1, 24.0), ["abc", "def", "gh"]);
+        assert_eq!(wrap_text("", 1, 24.0), [""]);
     }
 }

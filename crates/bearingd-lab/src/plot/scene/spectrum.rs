@@ -3,7 +3,9 @@
 
 use super::axes::{axis_titles, frame, grid, tick_labels_x, tick_labels_y};
 use super::{crisp, fit_text, text, text_width, Anchor, Item, PlotArea, Stroke};
-use super::{FIGURE_WIDTH, GLYPH_SIZE, LINE_HEIGHT, PANEL_HEIGHT, PLOT_LEFT, PLOT_RIGHT_PAD};
+use super::{
+    BELOW_PLOT, FIGURE_WIDTH, LINE_HEIGHT, PANEL_HEIGHT, PLOT_LEFT, PLOT_RIGHT_PAD, TEXT_HEIGHT,
+};
 use super::{TEXT_COLOR, TEXT_SCALE};
 use crate::plot::figure::{Color, SpectrumPanel};
 use crate::plot::layout::{decimate_min_max, finite_range, Axis, PixelScale};
@@ -31,7 +33,7 @@ fn stagger_labels(labels: Vec<(f64, String, Color)>) -> (Vec<PlacedLabel>, usize
     let mut rows: [Vec<(f64, f64)>; MAX_MARKER_ROWS] = Default::default();
     let mut placed = Vec::new();
     for (marker_x, label, color) in labels.into_iter().take(MAX_LABELS_TRIED) {
-        let text = fit_text(&label, TEXT_SCALE, 160.0);
+        let text = fit_text(&label, TEXT_SCALE, 320.0);
         let width = text_width(&text, TEXT_SCALE);
         let left = (marker_x - width / 2.0).clamp(4.0, FIGURE_WIDTH - 4.0 - width);
         let right = left + width;
@@ -92,7 +94,8 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
         .collect();
 
     // y axis from what is visible.
-    let visible_y = thinned.iter().flatten().map(|&(_, y)| y);
+    let levels = panel.levels.iter().map(|l| l.y).filter(|y| y.is_finite());
+    let visible_y = thinned.iter().flatten().map(|&(_, y)| y).chain(levels);
     let y_axis = if panel.log_y {
         Axis::log_for_data(finite_range(visible_y.filter(|&y| y > 0.0)))
     } else {
@@ -120,7 +123,7 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
         left: plot_left,
         right: plot_right,
         top: (labels_top + label_rows as f64 * LINE_HEIGHT + 6.0).round(),
-        bottom: (top + PANEL_HEIGHT - 52.0).round(),
+        bottom: (top + PANEL_HEIGHT - BELOW_PLOT).round(),
     };
     let y_scale = PixelScale {
         axis: y_axis,
@@ -173,7 +176,7 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
         let leader_x = crisp(label.marker_x);
         if leader_is_clear(label, &labels) {
             items.push(Item::Polyline {
-                points: vec![(leader_x, y + GLYPH_SIZE + 2.0), (leader_x, area.top)],
+                points: vec![(leader_x, y + TEXT_HEIGHT + 2.0), (leader_x, area.top)],
                 stroke: Stroke {
                     color: label.color.with_alpha(label.color.a / 2),
                     width: 1.0,
@@ -214,11 +217,64 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
         }
     }
 
+    reference_lines(items, &area, &y_scale, panel);
     frame(items, &area);
     tick_labels_x(items, &area, &x_scale, &x_ticks);
     tick_labels_y(items, &area, &y_scale, &y_ticks);
     axis_titles(items, &area, &panel.x_label, &panel.y_label);
     legend(items, &area, legend_y, panel);
+}
+
+/// The panel's horizontal reference lines, each labelled above its line at the right end of
+/// the plot (below it when there is no room above). A label that would overlap one placed
+/// before it is left out; its line is still drawn.
+fn reference_lines(
+    items: &mut Vec<Item>,
+    area: &PlotArea,
+    y_scale: &PixelScale,
+    panel: &SpectrumPanel,
+) {
+    let height = TEXT_HEIGHT;
+    let mut taken: Vec<(f64, f64)> = Vec::new();
+    for level in &panel.levels {
+        let Some(py) = y_scale.to_pixel(level.y) else {
+            continue;
+        };
+        if !(area.top..=area.bottom).contains(&py) {
+            continue;
+        }
+        let py = crisp(py);
+        items.push(Item::Polyline {
+            points: vec![(area.left, py), (area.right, py)],
+            stroke: Stroke {
+                color: level.color,
+                width: 1.5,
+                dash: level.dashed.then_some((8.0, 4.0)),
+            },
+        });
+        let above = py - height - 3.0;
+        let y = if above >= area.top + 2.0 {
+            above
+        } else {
+            py + 3.0
+        };
+        if y + height > area.bottom
+            || taken
+                .iter()
+                .any(|&(a, b)| y < b + 2.0 && a < y + height + 2.0)
+        {
+            continue;
+        }
+        taken.push((y, y + height));
+        items.push(text(
+            area.right - 6.0,
+            y,
+            fit_text(&level.label, TEXT_SCALE, area.width() / 2.0),
+            TEXT_SCALE,
+            Anchor::End,
+            level.color,
+        ));
+    }
 }
 
 /// Series legend, right-aligned in a row above the marker labels: a short line sample and the
@@ -231,7 +287,7 @@ fn legend(items: &mut Vec<Item>, area: &PlotArea, y: f64, panel: &SpectrumPanel)
         .series
         .iter()
         .filter(|s| !s.label.is_empty())
-        .map(|s| (fit_text(&s.label, TEXT_SCALE, 240.0), s.color))
+        .map(|s| (fit_text(&s.label, TEXT_SCALE, 640.0), s.color))
         .collect();
     let mut right = area.right;
     for (label, color) in entries.iter().rev() {
@@ -242,7 +298,7 @@ fn legend(items: &mut Vec<Item>, area: &PlotArea, y: f64, panel: &SpectrumPanel)
         if sample_left < area.left {
             break;
         }
-        let mid = crisp(y + GLYPH_SIZE / 2.0 - 1.0);
+        let mid = crisp(y + TEXT_HEIGHT / 2.0 - 1.0);
         items.push(Item::Polyline {
             points: vec![(sample_left, mid), (sample_right, mid)],
             stroke: Stroke::solid(*color, 2.5),
