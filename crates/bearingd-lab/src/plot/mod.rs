@@ -92,6 +92,25 @@ impl ImageFormat {
     }
 }
 
+/// Where a line of text lands on the canvas, in pixels (y down).
+#[doc(hidden)]
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextBox {
+    pub content: String,
+    pub left: f64,
+    pub top: f64,
+    pub right: f64,
+    pub bottom: f64,
+}
+
+/// For layout tests: the canvas size of `figure` and the box of every non-empty text in it.
+#[doc(hidden)]
+pub fn text_boxes(figure: &Figure) -> Result<(u32, u32, Vec<TextBox>), PlotError> {
+    let scene = scene::build(figure)?;
+    let boxes = scene.text_boxes();
+    Ok((scene.width, scene.height, boxes))
+}
+
 /// Renders `figure` as an SVG document.
 pub fn render_svg(figure: &Figure) -> Result<String, PlotError> {
     Ok(svg::write_svg(&scene::build(figure)?))

@@ -134,6 +134,36 @@ pub(crate) struct Scene {
     pub items: Vec<Item>,
 }
 
+impl Scene {
+    /// The box each non-empty text covers, as the PNG renderer draws it.
+    pub(crate) fn text_boxes(&self) -> Vec<super::TextBox> {
+        self.items
+            .iter()
+            .filter_map(|item| match item {
+                Item::Text(t) if !t.content.is_empty() => Some(t),
+                _ => None,
+            })
+            .map(|t| {
+                let length = text_width(&t.content, t.scale);
+                let thickness = GLYPH_SIZE * f64::from(t.scale);
+                let before = length * t.anchor.offset_fraction();
+                let (left, top, right, bottom) = if t.vertical {
+                    (t.x, t.y + before - length, t.x + thickness, t.y + before)
+                } else {
+                    (t.x - before, t.y, t.x - before + length, t.y + thickness)
+                };
+                super::TextBox {
+                    content: t.content.clone(),
+                    left,
+                    top,
+                    right,
+                    bottom,
+                }
+            })
+            .collect()
+    }
+}
+
 /// Width in pixels of `text` at `scale`.
 pub(crate) fn text_width(text: &str, scale: u32) -> f64 {
     text.chars().count() as f64 * GLYPH_SIZE * f64::from(scale)
