@@ -97,8 +97,11 @@ fn issue16_analyze_reports_velocity_rms_and_zone_of_an_analytic_sine() {
     );
 }
 
+/// Samples in fractions of full scale have no scale to g: no velocity, and the report says why
+/// and how to state the unit. (A float WAV as `simulate` writes it is g since issue 33 item 4;
+/// `--unit full-scale` makes it relative, as an integer WAV is: tests/suite/formats.rs.)
 #[test]
-fn issue16_a_wav_has_no_velocity_and_says_why() {
+fn issue16_a_record_in_full_scale_units_has_no_velocity_and_says_why() {
     let dir = scratch_dir("severity-wav");
     let wav = dir.join("rec.wav");
     let made = bearingd(&[
@@ -116,16 +119,17 @@ fn issue16_a_wav_has_no_velocity_and_says_why() {
         "1772",
         "--bearing",
         "skf-6205-2rs",
+        "--unit",
+        "full-scale",
         "--format",
         "json",
     ]);
     assert!(out.status.success());
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert!(report["velocity"].is_null());
+    let notes = report["notes"].to_string();
     assert!(
-        report["notes"]
-            .to_string()
-            .contains("no ISO 10816-3 velocity"),
+        notes.contains("no ISO 10816-3 velocity") && notes.contains("--unit g"),
         "{report:#}"
     );
 }
