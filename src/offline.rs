@@ -399,6 +399,7 @@ pub fn analyze_recording(
         rpm_source,
         bearing,
         selection: request.settings.band_selection,
+        unit: recording.unit,
         notes,
         warnings,
     };

@@ -17,6 +17,7 @@ use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::bearing::BearingGeometry;
 use crate::learned::{Basis, Combined, LearnedOpinion};
 use crate::messages::FaultKind;
+use crate::recording::SampleUnit;
 use crate::twin::diagnose::{ResidualSummary, TwinDiagnosis};
 use crate::twin::{HypothesisFit, TwinParams};
 use serde::Serialize;
@@ -44,6 +45,8 @@ pub struct RecordContext {
     pub rpm_source: SpeedSource,
     pub bearing: BearingGeometry,
     pub selection: BandSelection,
+    /// What the samples are in: g, or fractions of a recorder's full scale.
+    pub unit: SampleUnit,
     /// What was assumed (shown as `note:`).
     pub notes: Vec<String>,
     /// What is wrong with the record as read (shown as `warning:`).
@@ -111,12 +114,24 @@ pub struct ExplainedScore {
     pub significance: f64,
 }
 
+/// `SampleUnit` as the analyze JSON names it.
+fn unit_name<S: serde::Serializer>(unit: &SampleUnit, serializer: S) -> Result<S::Ok, S::Error> {
+    serializer.serialize_str(match unit {
+        SampleUnit::G => "g",
+        SampleUnit::FullScale => "full_scale",
+    })
+}
+
 /// The JSON document of `bearingd analyze --format json`.
 #[derive(Debug, Clone, Serialize)]
 pub struct AnalyzeReport {
     pub file: String,
     pub channel: String,
     pub fs_hz: f64,
+    /// What the samples (and so every amplitude of the report) are in: `g`, or `full_scale`
+    /// when the recorder's full scale is unknown (an integer WAV): amplitudes are then relative.
+    #[serde(serialize_with = "unit_name")]
+    pub unit: SampleUnit,
     pub rpm: f64,
     pub rpm_source: SpeedSource,
     pub bearing: String,
@@ -144,8 +159,8 @@ pub struct AnalyzeReport {
     pub thresholds: Thresholds,
     pub indicators: Indicators,
     pub hypotheses: Vec<HypothesisReport>,
-    /// ISO 10816-3 / 20816-3 velocity severity and zone; `null` when the record is not in g
-    /// (WAV) or too short.
+    /// ISO 10816-3 / 20816-3 velocity severity and zone; `null` when the samples are not in
+    /// physical units (`unit` is `full_scale`) or the record is too short.
     pub velocity: Option<VelocitySeverity>,
     /// What the detectors that judge whole records found, each under its own key
     /// (`machine_faults`; [`crate::analysis::detectors`]).
@@ -402,6 +417,7 @@ impl AnalyzeReport {
             file: context.file.clone(),
             channel: context.channel.clone(),
             fs_hz: analysis.fs_hz,
+            unit: context.unit,
             rpm: context.rpm,
             rpm_source: context.rpm_source,
             bearing: context.bearing.name.clone(),

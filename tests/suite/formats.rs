@@ -373,6 +373,8 @@ fn issue33_what_simulate_writes_as_wav_is_read_in_g_with_its_channel_name() {
     // The same values, the same unit, the same channel name as the CSV column.
     assert_eq!(from_wav["channel"], "accel_g");
     assert_eq!(from_csv["channel"], "accel_g");
+    assert_eq!(from_wav["unit"], "g");
+    assert_eq!(from_csv["unit"], "g");
     let (v_wav, v_csv) = (velocity_mm_s(&from_wav), velocity_mm_s(&from_csv));
     assert!(
         (v_wav - v_csv).abs() <= 1e-6 * v_csv,
@@ -423,6 +425,10 @@ fn issue33_an_integer_wav_is_relative_until_its_unit_is_stated() {
     let relative = analyze_json(&wav, &given);
     assert_eq!(relative["channel"], "1", "no iXML chunk: numbered");
     assert!(relative["velocity"].is_null(), "{relative:#}");
+    assert_eq!(
+        relative["unit"], "full_scale",
+        "the JSON says the amplitudes are relative"
+    );
     assert!(
         notes_of(&relative).contains("fractions of full scale"),
         "{}",
@@ -436,6 +442,7 @@ fn issue33_an_integer_wav_is_relative_until_its_unit_is_stated() {
         &[&given[..], &["--fs", "12000"]].concat(),
     ));
     let stated = analyze_json(&wav, &[&given[..], &["--unit", "g"]].concat());
+    assert_eq!(stated["unit"], "g");
     let expected = csv_v / full_scale;
     let got = velocity_mm_s(&stated);
     assert!(
