@@ -122,6 +122,10 @@ pub struct SpectrumPanel {
     /// Horizontal reference lines (e.g. zone boundaries), labelled at the right end.
     #[serde(default)]
     pub levels: Vec<Level>,
+    /// What the marker colours, line styles and shading mean, listed after the series in the
+    /// legend row above the plot.
+    #[serde(default)]
+    pub legend: Vec<LegendEntry>,
 }
 
 impl SpectrumPanel {
@@ -137,6 +141,7 @@ impl SpectrumPanel {
             x_range: None,
             log_y: false,
             levels: Vec::new(),
+            legend: Vec::new(),
         }
     }
 }
@@ -156,6 +161,25 @@ pub struct Marker {
     pub label: String,
     pub color: Color,
     pub dashed: bool,
+}
+
+/// A legend entry: a sample drawn in `color` and what it stands for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LegendEntry {
+    pub label: String,
+    pub color: Color,
+    pub sample: LegendSample,
+}
+
+/// How a legend entry's sample is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum LegendSample {
+    /// A short solid line, like a series or a solid marker.
+    Line,
+    /// A short dashed line, like a dashed marker.
+    DashedLine,
+    /// A filled box, like a shaded band.
+    Band,
 }
 
 /// A horizontal line at `y` across a spectrum panel, labelled at its right end; the y axis

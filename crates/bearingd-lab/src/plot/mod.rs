@@ -38,7 +38,8 @@ mod svg;
 use std::path::{Path, PathBuf};
 
 pub use figure::{
-    Color, Figure, HeatmapPanel, HeatmapRow, Level, Marker, Panel, Series, Shade, SpectrumPanel,
+    Color, Figure, HeatmapPanel, HeatmapRow, LegendEntry, LegendSample, Level, Marker, Panel,
+    Series, Shade, SpectrumPanel,
 };
 
 /// File extensions [`save`] understands, lower case and without the dot.

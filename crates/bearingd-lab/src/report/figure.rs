@@ -5,7 +5,8 @@ use crate::analysis::iso::VelocitySeverity;
 use crate::analysis::{BandSelection, RecordAnalysis};
 use crate::messages::FaultKind;
 use crate::plot::{
-    Color, Figure, HeatmapPanel, HeatmapRow, Level, Marker, Series, Shade, SpectrumPanel,
+    Color, Figure, HeatmapPanel, HeatmapRow, LegendEntry, LegendSample, Level, Marker, Series,
+    Shade, SpectrumPanel,
 };
 use crate::twin::diagnose::TwinDiagnosis;
 use bearingd::report::AnalyzeReport;
@@ -143,6 +144,7 @@ fn fault_markers(
     const MAX_ORDER: usize = 200;
     let diagnosed = analysis.diagnosis.verdict.fault();
     let kinds = [FaultKind::OuterRace, FaultKind::InnerRace, FaultKind::Ball];
+    fault_legend(panel, analysis, &kinds, scored, tolerance, x_max);
     panel.markers.push(Marker {
         x: analysis.frequencies.shaft,
         label: "1x shaft".into(),
@@ -189,6 +191,51 @@ fn fault_markers(
     }
 }
 
+/// The legend of the fault markers: each fault's colour (solid for the diagnosed fault, dashed
+/// for the others), the paler lines of harmonics the diagnosis does not score, and the
+/// shaded tolerance windows of those it does.
+fn fault_legend(
+    panel: &mut SpectrumPanel,
+    analysis: &RecordAnalysis,
+    kinds: &[FaultKind],
+    scored: usize,
+    tolerance: f64,
+    x_max: f64,
+) {
+    let diagnosed = analysis.diagnosis.verdict.fault();
+    for &kind in kinds {
+        let f = kind.frequency(&analysis.frequencies);
+        if !(f > 0.0 && f <= x_max) {
+            continue;
+        }
+        let is_diagnosed = diagnosed == Some(kind);
+        panel.legend.push(LegendEntry {
+            label: format!(
+                "{} {}{}",
+                kind.frequency_label(),
+                kind.name().replace('_', " "),
+                if is_diagnosed { " (diagnosed)" } else { "" }
+            ),
+            color: fault_color(kind),
+            sample: if is_diagnosed {
+                LegendSample::Line
+            } else {
+                LegendSample::DashedLine
+            },
+        });
+    }
+    panel.legend.push(LegendEntry {
+        label: format!("pale: harmonic above x{scored}, not scored"),
+        color: Color::GREY.with_alpha(110),
+        sample: LegendSample::Line,
+    });
+    panel.legend.push(LegendEntry {
+        label: format!("shaded: ±{:.0} % window scored", tolerance * 100.0),
+        color: Color::GREY.with_alpha(60),
+        sample: LegendSample::Band,
+    });
+}
+
 /// The velocity spectrum the ISO 10816-3 value sums (RMS per bin, in the standard's band),
 /// with the shaft harmonics marked: where the velocity comes from (unbalance at 1x,
 /// misalignment at 2x, or broadband).
@@ -212,6 +259,14 @@ fn velocity_panel(v: &VelocitySeverity, shaft_hz: f64) -> SpectrumPanel {
         x0: v.band_hz[0],
         x1: v.band_hz[1],
         color: Color::GREY.with_alpha(25),
+    });
+    panel.legend.push(LegendEntry {
+        label: format!(
+            "shaded: ISO band {:.0}-{:.0} Hz",
+            v.band_hz[0], v.band_hz[1]
+        ),
+        color: Color::GREY.with_alpha(60),
+        sample: LegendSample::Band,
     });
     // The zone boundaries apply to the overall RMS (the root of the sum over the bins): the
     // overall value is drawn with them, and one bin alone reaching a line reaches that zone.
@@ -274,6 +329,23 @@ fn twin_panel(twin: &TwinDiagnosis, analysis: &RecordAnalysis, tolerance: f64) -
     });
     let f = fit.params.f_d;
     let nominal = fit.fault.frequency(&analysis.frequencies);
+    panel.legend.push(LegendEntry {
+        label: format!(
+            "{} of the twin and its harmonics",
+            fit.fault.frequency_label()
+        ),
+        color: fault_color(fit.fault),
+        sample: LegendSample::DashedLine,
+    });
+    panel.legend.push(LegendEntry {
+        label: format!(
+            "shaded: ±{:.0} % around the nominal {}",
+            tolerance * 100.0,
+            fit.fault.frequency_label()
+        ),
+        color: fault_color(fit.fault).with_alpha(60),
+        sample: LegendSample::Band,
+    });
     for order in 1..=10 {
         let at = order as f64 * f;
         if at > x_max {

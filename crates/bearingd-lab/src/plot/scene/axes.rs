@@ -1,9 +1,9 @@
 //! What every panel draws around its data: the grid, the frame, tick marks with their labels,
 //! and the axis titles.
 
-use super::TEXT_SCALE;
-use super::{crisp, fit_text, text, text_width, wrap_text, Anchor, Item, PlotArea, Stroke, Text};
+use super::{crisp, fitted, text, text_width, wrap_text, Anchor, Item, PlotArea, Stroke, Text};
 use super::{FRAME_COLOR, GRID_COLOR, LINE_HEIGHT, OUTER_PAD, PLOT_LEFT, TEXT_COLOR, TEXT_HEIGHT};
+use super::{GLYPH_SIZE, TEXT_SCALE};
 use crate::plot::layout::{PixelScale, Tick};
 
 pub(super) fn grid(
@@ -98,11 +98,12 @@ pub(super) fn tick_labels_y(
             points: vec![(area.left - TICK_LENGTH, py), (area.left, py)],
             stroke: Stroke::solid(FRAME_COLOR, 1.0),
         });
+        let (label, scale) = fitted(&tick.label, TEXT_SCALE, Y_TICK_LABEL_WIDTH);
         items.push(text(
             area.left - TICK_LENGTH - 4.0,
-            py - TEXT_HEIGHT / 2.0,
-            fit_text(&tick.label, TEXT_SCALE, Y_TICK_LABEL_WIDTH),
-            TEXT_SCALE,
+            py - GLYPH_SIZE * f64::from(scale) / 2.0,
+            label,
+            scale,
             Anchor::End,
             TEXT_COLOR,
         ));
@@ -111,32 +112,39 @@ pub(super) fn tick_labels_y(
 
 pub(super) fn axis_titles(items: &mut Vec<Item>, area: &PlotArea, x_label: &str, y_label: &str) {
     if !x_label.is_empty() {
+        let (label, scale) = fitted(x_label, TEXT_SCALE, area.width());
         items.push(text(
             (area.left + area.right) / 2.0,
             area.bottom + TICK_LENGTH + 4.0 + LINE_HEIGHT + 8.0,
-            fit_text(x_label, TEXT_SCALE, area.width()),
-            TEXT_SCALE,
+            label,
+            scale,
             Anchor::Middle,
             TEXT_COLOR,
         ));
     }
-    // The y title reads bottom to top, wrapped onto at most two lines beside each other.
-    let lines = wrap_text(y_label, TEXT_SCALE, area.height());
-    let shown = lines.len().min(2);
+    // The y title reads bottom to top, on at most two lines beside each other, or four in
+    // the smaller font when two lines of the body font cannot hold it.
+    let (scale, max_lines) = if wrap_text(y_label, TEXT_SCALE, area.height()).len() <= 2 {
+        (TEXT_SCALE, 2)
+    } else {
+        (1, 4)
+    };
+    let lines = wrap_text(y_label, scale, area.height());
+    let shown = lines.len().min(max_lines);
     for (i, line) in lines.iter().take(shown).enumerate() {
-        let line = if i + 1 == shown && lines.len() > shown {
-            fit_text(&lines[i..].join(" "), TEXT_SCALE, area.height())
+        let (line, scale) = if i + 1 == shown && lines.len() > shown {
+            fitted(&lines[i..].join(" "), scale, area.height())
         } else {
-            line.clone()
+            (line.clone(), scale)
         };
         if line.is_empty() {
             continue;
         }
         items.push(Item::Text(Text {
-            x: OUTER_PAD + i as f64 * (TEXT_HEIGHT + 4.0),
+            x: OUTER_PAD + i as f64 * (GLYPH_SIZE * f64::from(scale) + 4.0),
             y: (area.top + area.bottom) / 2.0,
             content: line,
-            scale: TEXT_SCALE,
+            scale,
             anchor: Anchor::Middle,
             color: TEXT_COLOR,
             vertical: true,

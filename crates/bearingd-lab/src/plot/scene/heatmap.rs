@@ -2,11 +2,11 @@
 //! more than pixels, the chosen cell outlined with its caption, and the colour bar.
 
 use super::axes::{axis_titles, frame, tick_labels_x, TICK_LENGTH, Y_TICK_LABEL_WIDTH};
-use super::{crisp, fit_text, text, text_width, Anchor, Item, PlotArea, Stroke, Text};
+use super::{crisp, fitted, text, text_width, Anchor, Item, PlotArea, Stroke, Text};
 use super::{
     BELOW_PLOT, FIGURE_WIDTH, LINE_HEIGHT, PANEL_HEIGHT, PLOT_LEFT, PLOT_RIGHT_PAD, TEXT_HEIGHT,
 };
-use super::{FRAME_COLOR, TEXT_COLOR, TEXT_SCALE};
+use super::{FRAME_COLOR, GLYPH_SIZE, OUTER_PAD, TEXT_COLOR, TEXT_SCALE};
 use crate::plot::figure::{Color, HeatmapPanel};
 use crate::plot::layout::{finite_range, format_number, Axis, PixelScale};
 
@@ -77,7 +77,8 @@ pub(super) fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item
     let area = PlotArea {
         left: PLOT_LEFT,
         right: FIGURE_WIDTH - PLOT_RIGHT_PAD - COLOR_BAR_AREA,
-        top: top + 4.0 + LINE_HEIGHT + 10.0,
+        // Two rows above the plot: the panel's title, then what the outline marks.
+        top: top + 4.0 + 2.0 * LINE_HEIGHT + 10.0,
         bottom: (top + PANEL_HEIGHT - BELOW_PLOT).round(),
     };
     let x_max = if panel.x_max.is_finite() && panel.x_max > 0.0 {
@@ -102,12 +103,14 @@ pub(super) fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item
         None => MISSING_CELL,
     };
 
-    // Panel title, and what the outline marks.
+    // Panel title, across the plot and the colour bar.
+    let header_width = FIGURE_WIDTH - OUTER_PAD - area.left;
+    let (title, scale) = fitted(&panel.title, TEXT_SCALE, header_width);
     items.push(text(
         area.left,
         top + 4.0,
-        fit_text(&panel.title, TEXT_SCALE, area.width() / 2.0),
-        TEXT_SCALE,
+        title,
+        scale,
         Anchor::Start,
         TEXT_COLOR,
     ));
@@ -173,11 +176,12 @@ pub(super) fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item
     let label_every = (LINE_HEIGHT / row_height).ceil().max(1.0) as usize;
     for (r, row) in panel.rows.iter().enumerate().step_by(label_every) {
         let centre = (row_edge(r) + row_edge(r + 1)) / 2.0;
+        let (label, scale) = fitted(&row.label, TEXT_SCALE, Y_TICK_LABEL_WIDTH);
         items.push(text(
             area.left - 6.0,
-            centre - TEXT_HEIGHT / 2.0,
-            fit_text(&row.label, TEXT_SCALE, Y_TICK_LABEL_WIDTH),
-            TEXT_SCALE,
+            centre - GLYPH_SIZE * f64::from(scale) / 2.0,
+            label,
+            scale,
             Anchor::End,
             TEXT_COLOR,
         ));
@@ -223,12 +227,13 @@ pub(super) fn heatmap_panel(panel: &HeatmapPanel, top: f64, items: &mut Vec<Item
                 panel.value_label,
                 format_number(value, value.abs() / 100.0),
             );
+            let (caption, scale) = fitted(&caption, TEXT_SCALE, header_width);
             items.push(text(
-                area.right,
-                top + 4.0,
-                fit_text(&caption, TEXT_SCALE, area.width() / 2.0 - 8.0),
-                TEXT_SCALE,
-                Anchor::End,
+                area.left,
+                top + 4.0 + LINE_HEIGHT,
+                caption,
+                scale,
+                Anchor::Start,
                 TEXT_COLOR,
             ));
         }
@@ -292,11 +297,12 @@ fn color_bar(items: &mut Vec<Item>, area: &PlotArea, values: Axis, label: &str) 
         ));
     }
     if !label.is_empty() {
+        let (content, scale) = fitted(label, TEXT_SCALE, bar.height());
         items.push(Item::Text(Text {
             x: (bar.right + TICK_LENGTH + 4.0 + widest + 8.0).min(FIGURE_WIDTH - TEXT_HEIGHT - 4.0),
             y: (bar.top + bar.bottom) / 2.0,
-            content: fit_text(label, TEXT_SCALE, bar.height()),
-            scale: TEXT_SCALE,
+            content,
+            scale,
             anchor: Anchor::Middle,
             color: TEXT_COLOR,
             vertical: true,

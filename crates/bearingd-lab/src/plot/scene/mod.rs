@@ -8,6 +8,7 @@
 
 mod axes;
 mod heatmap;
+mod legend;
 mod spectrum;
 
 use super::figure::{Color, Figure, Panel};
@@ -25,7 +26,8 @@ const FIGURE_WIDTH: f64 = 1600.0;
 const PANEL_HEIGHT: f64 = 480.0;
 /// More panels than this would make an unreasonably tall image.
 pub(crate) const MAX_PANELS: usize = 16;
-/// Notes beyond this many lines are summarised as "… n more".
+/// Notes beyond this many lines are summarised as "... n more lines" (an analysis figure has
+/// three or four notes of at most three lines each).
 const MAX_NOTE_LINES: usize = 12;
 
 const OUTER_PAD: f64 = 16.0;
@@ -169,20 +171,35 @@ pub(crate) fn text_width(text: &str, scale: u32) -> f64 {
     text.chars().count() as f64 * GLYPH_SIZE * f64::from(scale)
 }
 
-/// `text` shortened with "..." so that it fits `max_width` pixels at `scale`.
-fn fit_text(text: &str, scale: u32, max_width: f64) -> String {
-    let capacity = (max_width / (GLYPH_SIZE * f64::from(scale)))
+/// Characters of the 8×8 font that fit `max_width` pixels at `scale`.
+fn capacity(scale: u32, max_width: f64) -> usize {
+    (max_width / (GLYPH_SIZE * f64::from(scale)))
         .floor()
-        .max(0.0) as usize;
-    if text.chars().count() <= capacity {
-        return text.to_string();
+        .max(0.0) as usize
+}
+
+/// `text` and the scale to set it at so that it fits `max_width` pixels: `scale` if it fits,
+/// else half of it (down to the 8 px font) rather than cutting it. Only a text too long even
+/// at 8 px is cut, ending in "...": a last resort for labels no figure of ours makes (our
+/// longest labels fit at the full scale; the half scale doubles the room).
+fn fitted(text: &str, scale: u32, max_width: f64) -> (String, u32) {
+    let length = text.chars().count();
+    let mut scale = scale.max(1);
+    while length > capacity(scale, max_width) && scale > 1 {
+        scale = (scale / 2).max(1);
     }
-    if capacity <= 3 {
-        return text.chars().take(capacity).collect();
+    let room = capacity(scale, max_width);
+    if length <= room {
+        return (text.to_string(), scale);
     }
-    let mut short: String = text.chars().take(capacity - 3).collect();
-    short.push_str("...");
-    short
+    let cut = if room <= 3 {
+        text.chars().take(room).collect()
+    } else {
+        let mut short: String = text.chars().take(room - 3).collect();
+        short.push_str("...");
+        short
+    };
+    (cut, scale)
 }
 
 /// Half-pixel aligned coordinate so that a 1 px line covers exactly one pixel row or column.
@@ -320,10 +337,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn text_is_shortened_to_fit() {
-        assert_eq!(fit_text("abcdefgh", 1, 48.0), "abc...");
-        assert_eq!(fit_text("abc", 1, 48.0), "abc");
-        assert_eq!(fit_text("abc", 1, 0.0), "");
+    fn text_is_shrunk_to_fit_and_cut_only_past_the_smallest_font() {
+        let s = |text: &str, scale: u32| (String::from(text), scale);
+        assert_eq!(fitted("abc", 2, 48.0), s("abc", 2));
+        assert_eq!(fitted("abcdef", 2, 48.0), s("abcdef", 1));
+        assert_eq!(fitted("abcdefgh", 2, 48.0), s("abc...", 1));
+        assert_eq!(fitted("abc", 2, 0.0), s("", 1));
     }
 
     #[test]

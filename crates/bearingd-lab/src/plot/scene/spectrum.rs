@@ -2,11 +2,12 @@
 //! labels staggered over a few rows so that neighbours stay readable, and the legend.
 
 use super::axes::{axis_titles, frame, grid, tick_labels_x, tick_labels_y};
-use super::{crisp, fit_text, text, text_width, Anchor, Item, PlotArea, Stroke};
+use super::legend;
+use super::TEXT_SCALE;
+use super::{crisp, fitted, text, text_width, Anchor, Item, PlotArea, Stroke};
 use super::{
     BELOW_PLOT, FIGURE_WIDTH, LINE_HEIGHT, PANEL_HEIGHT, PLOT_LEFT, PLOT_RIGHT_PAD, TEXT_HEIGHT,
 };
-use super::{TEXT_COLOR, TEXT_SCALE};
 use crate::plot::figure::{Color, SpectrumPanel};
 use crate::plot::layout::{decimate_min_max, finite_range, Axis, PixelScale};
 
@@ -17,6 +18,7 @@ const MAX_MARKER_ROWS: usize = 4;
 struct PlacedLabel {
     x: f64,
     text: String,
+    scale: u32,
     row: usize,
     color: Color,
     marker_x: f64,
@@ -33,8 +35,8 @@ fn stagger_labels(labels: Vec<(f64, String, Color)>) -> (Vec<PlacedLabel>, usize
     let mut rows: [Vec<(f64, f64)>; MAX_MARKER_ROWS] = Default::default();
     let mut placed = Vec::new();
     for (marker_x, label, color) in labels.into_iter().take(MAX_LABELS_TRIED) {
-        let text = fit_text(&label, TEXT_SCALE, 320.0);
-        let width = text_width(&text, TEXT_SCALE);
+        let (text, scale) = fitted(&label, TEXT_SCALE, 320.0);
+        let width = text_width(&text, scale);
         let left = (marker_x - width / 2.0).clamp(4.0, FIGURE_WIDTH - 4.0 - width);
         let right = left + width;
         let free = |row: &Vec<(f64, f64)>| {
@@ -46,6 +48,7 @@ fn stagger_labels(labels: Vec<(f64, String, Color)>) -> (Vec<PlacedLabel>, usize
             placed.push(PlacedLabel {
                 x: left,
                 text,
+                scale,
                 row,
                 color,
                 marker_x,
@@ -63,7 +66,7 @@ fn leader_is_clear(label: &PlacedLabel, all: &[PlacedLabel]) -> bool {
     all.iter()
         .filter(|other| other.row < label.row)
         .all(|other| {
-            let right = other.x + text_width(&other.text, TEXT_SCALE);
+            let right = other.x + text_width(&other.text, other.scale);
             label.marker_x < other.x - 1.0 || label.marker_x > right + 1.0
         })
 }
@@ -116,9 +119,10 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
             .collect(),
     );
 
-    // Vertical budget: legend row, marker label rows, plot, tick labels, x label.
+    // Vertical budget: legend rows, marker label rows, plot, tick labels, x label.
     let legend_y = top + 4.0;
-    let labels_top = legend_y + LINE_HEIGHT + 6.0;
+    let (legend, legend_rows) = legend::layout(panel, plot_left, plot_right);
+    let labels_top = legend_y + legend_rows as f64 * LINE_HEIGHT + 6.0;
     let area = PlotArea {
         left: plot_left,
         right: plot_right,
@@ -188,7 +192,7 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
             label.x,
             y,
             label.text.clone(),
-            TEXT_SCALE,
+            label.scale,
             Anchor::Start,
             label.color,
         ));
@@ -222,7 +226,7 @@ pub(super) fn spectrum_panel(panel: &SpectrumPanel, top: f64, items: &mut Vec<It
     tick_labels_x(items, &area, &x_scale, &x_ticks);
     tick_labels_y(items, &area, &y_scale, &y_ticks);
     axis_titles(items, &area, &panel.x_label, &panel.y_label);
-    legend(items, &area, legend_y, panel);
+    legend::draw(items, &legend, legend_y);
 }
 
 /// The panel's horizontal reference lines, each labelled above its line at the right end of
@@ -266,52 +270,15 @@ fn reference_lines(
             continue;
         }
         taken.push((y, y + height));
+        let (label, scale) = fitted(&level.label, TEXT_SCALE, area.width() / 2.0);
         items.push(text(
             area.right - 6.0,
             y,
-            fit_text(&level.label, TEXT_SCALE, area.width() / 2.0),
-            TEXT_SCALE,
+            label,
+            scale,
             Anchor::End,
             level.color,
         ));
-    }
-}
-
-/// Series legend, right-aligned in a row above the marker labels: a short line sample and the
-/// label for each series.
-fn legend(items: &mut Vec<Item>, area: &PlotArea, y: f64, panel: &SpectrumPanel) {
-    const SAMPLE: f64 = 22.0;
-    const SAMPLE_GAP: f64 = 6.0;
-    const ENTRY_GAP: f64 = 20.0;
-    let entries: Vec<_> = panel
-        .series
-        .iter()
-        .filter(|s| !s.label.is_empty())
-        .map(|s| (fit_text(&s.label, TEXT_SCALE, 640.0), s.color))
-        .collect();
-    let mut right = area.right;
-    for (label, color) in entries.iter().rev() {
-        let width = text_width(label, TEXT_SCALE);
-        let label_left = right - width;
-        let sample_right = label_left - SAMPLE_GAP;
-        let sample_left = sample_right - SAMPLE;
-        if sample_left < area.left {
-            break;
-        }
-        let mid = crisp(y + TEXT_HEIGHT / 2.0 - 1.0);
-        items.push(Item::Polyline {
-            points: vec![(sample_left, mid), (sample_right, mid)],
-            stroke: Stroke::solid(*color, 2.5),
-        });
-        items.push(text(
-            label_left,
-            y,
-            label.clone(),
-            TEXT_SCALE,
-            Anchor::Start,
-            TEXT_COLOR,
-        ));
-        right = sample_left - ENTRY_GAP;
     }
 }
 
