@@ -12,9 +12,24 @@
 //! titles) so that it reads on a normal screen, so rendering works on a headless
 //! edge box with no fonts, no fontconfig and no display.
 //!
-//! Ours stays, not `plotters`: its PNG text needs system fonts (font-kit) or a font file, and
-//! its SVG backend would replace only `svg.rs`; the layout (bands, fault markers, kurtogram) is
-//! ours either way, and one scene gives both formats the same picture.
+//! Ours stays, not `plotters`, measured on 2026-11-28 with a scratch "hello plot" (one line
+//! series, caption, axis titles, legend; PNG) on plotters 0.3.7, release build, stripped:
+//! - text through `ab_glyph` (bitmap backend + encoder): 24 crates, 11 of them new to this
+//!   workspace (`image`, `jpeg-decoder`, `ab_glyph`, `ttf-parser`, ...); no system library, but
+//!   it draws no text until a TTF is registered: a font file (343 KB for DejaVu Sans Mono)
+//!   must ship inside the binary, which came to 1.32 MB.
+//! - text through `ttf` (font-kit, the default): 38 crates, 20 new (`font-kit`,
+//!   `yeslogic-fontconfig-sys`, `freetype-sys`, `pathfinder_*`, ...); building needs
+//!   `libfontconfig1-dev` and `pkg-config` (a Debian apt package; present on this machine,
+//!   not on a bare edge box), and the binary (0.93 MB) links `libfontconfig.so.1` and
+//!   `libfreetype.so.6` and finds its fonts on the system at run time.
+//! - clean release builds of the scratch crate took 6 and 14 minutes of wall time on the
+//!   2-core machine shared with other builds (not comparable to an idle machine's figures).
+//!
+//! Either way the layout (legend, fault markers with staggered labels, tolerance bands, zone
+//! lines, kurtogram) would still be ours, its SVG backend would replace only `svg.rs`, and the
+//! render tests check our scene's text boxes, which plotters does not expose. Ours needs no
+//! new crate (tiny-skia was already here), no font file and no system library.
 //!
 //! ```no_run
 //! use bearingd_lab::plot::{self, Color, Figure, Marker, Series, SpectrumPanel};
