@@ -4,7 +4,7 @@
 
 use crate::life::{HwFrom, LifePoint, StageEvent, TrendHindsight};
 use crate::messages::HealthStage;
-use crate::plot::{Color, Figure, Marker, Series, Shade, SpectrumPanel};
+use crate::plot::{Color, Figure, LegendEntry, LegendSample, Marker, Series, Shade, SpectrumPanel};
 use serde::Serialize;
 use std::fmt::Write as _;
 
@@ -438,6 +438,23 @@ pub fn life_figure(report: &LifeReport) -> Figure {
     }
     let mut rms_panel = panel("RMS (g)", rms_x);
     rms_panel.log_y = true;
+    // What the shading means, once, on the top panel (the same stages shade every panel).
+    for stage in [
+        HealthStage::Learning,
+        HealthStage::Degrading,
+        HealthStage::Failing,
+    ] {
+        if let Some(color) = stage_color(stage).filter(|_| spans.iter().any(|s| s.0 == stage)) {
+            rms_panel.legend.push(LegendEntry {
+                label: match stage {
+                    HealthStage::Learning => "shaded: learning the baseline".into(),
+                    _ => format!("shaded: {}", stage.name()),
+                },
+                color,
+                sample: LegendSample::Band,
+            });
+        }
+    }
     rms_panel.series = vec![
         Series {
             label: "RMS".into(),
@@ -692,7 +709,14 @@ mod tests {
             (0..5).map(|i| point(i, i as f64, None, None)).collect(),
             vec![],
         );
-        assert_eq!(y_labels(&life_figure(&bare)), ["RMS (g)", "kurtosis"]);
+        let figure = life_figure(&bare);
+        assert_eq!(y_labels(&figure), ["RMS (g)", "kurtosis"]);
+        // The legend names the shading of the stages this life went through, and no other.
+        let legend: Vec<&str> = match &figure.panels[0] {
+            Panel::Spectrum(s) => s.legend.iter().map(|e| e.label.as_str()).collect(),
+            Panel::Heatmap(_) => Vec::new(),
+        };
+        assert_eq!(legend, ["shaded: learning the baseline"]);
         let full = report(
             (0..5)
                 .map(|i| point(i, i as f64, (i == 2).then_some(12.0), Some(2.0)))
