@@ -10,6 +10,7 @@
 //! that user's (`sinks::alerts::verify`); it never changes its own user (issue 32: it used to
 //! become the owner of the root directory, whoever made it). Root is told to use `runuser`.
 
+use super::format::FormatOrJsonArg;
 use super::run::embedded_config;
 use super::CliError;
 use crate::clock::wall_clock_now_ns;
@@ -36,9 +37,9 @@ pub struct AlertsArgs {
     /// The `--data-dir` of a `bearingd run` without a config (default ./bearingd-data).
     #[arg(long)]
     data_dir: Option<PathBuf>,
-    /// One JSON object per line instead of text.
-    #[arg(long)]
-    json: bool,
+    // With json, one JSON object per line instead of text.
+    #[command(flatten)]
+    format: FormatOrJsonArg,
     /// Exit after this many alerts (the active alerts printed at start count).
     #[arg(long)]
     count: Option<u64>,
@@ -72,7 +73,7 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
         .map(|t| Instant::now() + Duration::from_secs_f64(t));
     let left = || deadline.map(|d| d.saturating_duration_since(Instant::now()));
     let mut printer = Printer {
-        json: args.json,
+        json: args.format.json(),
         printed: 0,
     };
 
@@ -109,7 +110,7 @@ pub fn run(args: &AlertsArgs) -> Result<(), CliError> {
             other => printer.event(&other),
         }
     }
-    if !args.json {
+    if !args.format.json() {
         println!(
             "{} active alert(s) on {} (history of {})",
             active.len(),

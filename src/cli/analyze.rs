@@ -3,6 +3,7 @@
 //! this same command through [`run_with`] and adds the figure of each record), so that the
 //! service links no drawing code.
 
+use super::format::ReportFormat;
 use super::{CliError, RecordingArgs};
 use crate::analysis::iso::{Foundation, MachineGroup, SeveritySettings};
 use crate::analysis::record::RecordAnalyzer;
@@ -12,16 +13,6 @@ use crate::report::{render_text, AnalyzeReport};
 use crate::twin::hw::StateFilter;
 use clap::{Args, ValueEnum};
 use std::path::{Path, PathBuf};
-
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum OutputFormat {
-    /// A few lines per record for people.
-    Text,
-    /// One JSON document per record (a JSON array for several records).
-    Json,
-    /// One Markdown table row per record, for comparing many records.
-    Table,
-}
 
 #[derive(Clone, Copy, ValueEnum)]
 pub enum BandMethod {
@@ -43,7 +34,7 @@ pub struct AnalyzeArgs {
     recording: RecordingArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
-    format: OutputFormat,
+    format: ReportFormat,
     /// Draw the envelope spectrum and the kurtogram to this file (.png or .svg); with several
     /// records, the record's file name is added before the extension. Runs in bearingd-lab.
     #[arg(long)]
@@ -147,7 +138,7 @@ pub fn run_with(args: &AnalyzeArgs, on_record: &mut OnRecord) -> Result<(), CliE
             &args.files,
             &args.recording,
             args.hw_states.into(),
-            args.format == OutputFormat::Json,
+            args.format == ReportFormat::Json,
         );
     }
     let config = match &args.config {
@@ -173,7 +164,7 @@ pub fn run_with(args: &AnalyzeArgs, on_record: &mut OnRecord) -> Result<(), CliE
     let mut analyzer = RecordAnalyzer::default();
     let mut reports = Vec::new();
     let mut failures = Vec::new();
-    if args.format == OutputFormat::Table {
+    if args.format == ReportFormat::Table {
         println!("{}", table_header());
     }
     for file in &files {
@@ -199,13 +190,13 @@ pub fn run_with(args: &AnalyzeArgs, on_record: &mut OnRecord) -> Result<(), CliE
         };
         on_record(&outcome, files.len())?;
         match args.format {
-            OutputFormat::Text => print!("{}", render_text(&outcome.report)),
-            OutputFormat::Table => println!("{}", table_row(&outcome.report)),
-            OutputFormat::Json => {}
+            ReportFormat::Text => print!("{}", render_text(&outcome.report)),
+            ReportFormat::Table => println!("{}", table_row(&outcome.report)),
+            ReportFormat::Json => {}
         }
         reports.push(outcome.report);
     }
-    if args.format == OutputFormat::Json {
+    if args.format == ReportFormat::Json {
         let json = if reports.len() == 1 {
             serde_json::to_string_pretty(&reports[0])
         } else {

@@ -4,6 +4,7 @@
 //! recorded data goes through the daemon's pipeline with `bearingd replay DIR/*.mcap`. The
 //! same settings are also written as `DIR/replay.toml`, a starting point for `--config`.
 
+use super::format::{FormatArg, Remarks};
 use super::{CliError, RecordingArgs};
 use crate::offline::{resolve_conditions, AnalyzeRequest};
 use crate::recording::{read_recording, SampleUnit};
@@ -23,6 +24,8 @@ pub struct ImportArgs {
     /// Sensor id in the log.
     #[arg(long, default_value = "imported")]
     sensor: String,
+    #[command(flatten)]
+    format: FormatArg,
 }
 
 pub fn run(args: &ImportArgs) -> Result<(), CliError> {
@@ -35,14 +38,17 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         ..Default::default()
     };
     let conditions = resolve_conditions(&recording, &request, false).map_err(CliError::input)?;
-    for note in &conditions.notes {
-        eprintln!("bearingd: import: note: {note}");
-    }
-    for warning in &conditions.warnings {
-        eprintln!("bearingd: import: warning: {warning}");
-    }
+    let mut remarks = Remarks::new("bearingd: import", args.format.json());
+    conditions
+        .notes
+        .iter()
+        .for_each(|n| remarks.note(n.as_str()));
+    conditions
+        .warnings
+        .iter()
+        .for_each(|w| remarks.warning(w.as_str()));
     if recording.unit == SampleUnit::FullScale {
-        eprintln!("bearingd: import: warning: the log states its samples in g, so these fractions of full scale will be read as g (thresholds, velocity); give --unit g or --unit m/s2 if the recorder's full scale is known");
+        remarks.warning("the log states its samples in g, so these fractions of full scale will be read as g (thresholds, velocity); give --unit g or --unit m/s2 if the recorder's full scale is known");
     }
     let fs = conditions.fs_hz;
     let imported = import_recording(&Import {
@@ -63,12 +69,33 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
         .path
         .as_ref()
         .map_or("?".into(), |p| p.display().to_string());
+    let seconds = recording.samples.len() as f64 / fs;
+    let dated = crate::mcap_log::files::utc_text(origin_ns);
+    if args.format.json() {
+        println!(
+            "{}",
+            serde_json::json!({
+                "samples": recording.samples.len(),
+                "seconds": seconds,
+                "fs_hz": fs,
+                "g_per_count": written.scale,
+                "dated": dated,
+                "origin_ns": origin_ns,
+                "time_source": time_source.to_string(),
+                "log": path,
+                "config": written.config_path.display().to_string(),
+                "notes": remarks.notes,
+                "warnings": remarks.warnings,
+            })
+        );
+        return Ok(());
+    }
     println!(
         "imported {} samples ({:.2} s at {fs} Hz, {:.3e} g per count, dated {} from the {time_source}) into {path}; replay with: bearingd replay {path} (its settings are also in {})",
         recording.samples.len(),
-        recording.samples.len() as f64 / fs,
+        seconds,
         written.scale,
-        crate::mcap_log::files::utc_text(origin_ns),
+        dated,
         written.config_path.display()
     );
     Ok(())

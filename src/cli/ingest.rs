@@ -70,9 +70,9 @@ pub struct IngestArgs {
     /// Expect exactly N sensor-lost reports in total (a sender that stops is lost once).
     #[arg(long, value_name = "N")]
     expect_sensor_lost: Option<u64>,
-    /// Print the report as JSON.
-    #[arg(long)]
-    json: bool,
+    // With json, the report as JSON.
+    #[command(flatten)]
+    format: super::format::FormatOrJsonArg,
 }
 
 #[derive(Debug, serde::Serialize)]
@@ -93,7 +93,7 @@ pub fn run(args: &IngestArgs) -> Result<(), CliError> {
         .build()
         .map_err(|e| CliError::failure(format!("cannot start the async runtime: {e}")))?;
     let report = runtime.block_on(ingest(args))?;
-    if args.json {
+    if args.format.json() {
         let text = serde_json::to_string_pretty(&report)
             .map_err(|e| CliError::failure(format!("report: {e}")))?;
         println!("{text}");

@@ -11,6 +11,7 @@ pub mod analyze;
 pub mod completions;
 mod config_cmd;
 mod fleet_decode;
+pub mod format;
 mod hw_table;
 pub mod import;
 mod ingest;
@@ -146,6 +147,8 @@ enum Command {
     Validate {
         /// The TOML file to check.
         file: std::path::PathBuf,
+        #[command(flatten)]
+        format: format::FormatArg,
     },
     /// Run one source (SocketCAN or iceoryx2) alone and report what arrived.
     Ingest(ingest::IngestArgs),
@@ -212,7 +215,7 @@ pub fn main() -> ExitCode {
         Command::Trend(_) => Err(lab::exec_lab("trend")),
         Command::Evaluate(_) => Err(lab::exec_lab("evaluate")),
         Command::Calibrate(_) => Err(lab::exec_lab("calibrate")),
-        Command::Validate { file } => config_cmd::validate(&file),
+        Command::Validate { file, format } => config_cmd::validate(&file, format),
         Command::Config { action } => config_cmd::run(&action),
         Command::Ingest(args) => ingest::run(&args),
         Command::FleetDecode(args) => fleet_decode::run(&args),

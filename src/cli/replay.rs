@@ -5,6 +5,7 @@
 //! override changes, the order the files are read in, run boundaries, gaps and what could not
 //! be read.
 
+use super::format::FormatOrJsonArg;
 use super::progress::ProgressLine;
 use super::run::{event_line, print_events};
 use super::CliError;
@@ -42,9 +43,9 @@ pub struct ReplayArgs {
     /// No progress (neither the bar on a terminal nor the lines elsewhere).
     #[arg(long)]
     quiet: bool,
-    /// Print the summary as JSON (flags with their sample times).
-    #[arg(long)]
-    json: bool,
+    // With json, the summary as one line of JSON (flags with their sample times).
+    #[command(flatten)]
+    format: FormatOrJsonArg,
 }
 
 /// Where the replay's settings came from.
@@ -107,7 +108,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
     };
     let events = match &bar {
         Some(bar) => line_events(Arc::clone(bar)),
-        None => print_events(),
+        None => print_events(args.format.json()),
     };
     let mut open_sinks = |run: &RunStart| -> Result<Vec<Box<dyn Sink>>, SinkError> {
         let sinks = assemble(
@@ -123,7 +124,7 @@ pub fn run(args: &ReplayArgs) -> Result<(), CliError> {
         bar.clear();
     }
     let summary = replayed.map_err(CliError::failure)?;
-    if args.json {
+    if args.format.json() {
         print_json(&summary, &plan, from, &config_differences);
     } else {
         print_text(&summary, &args.out);

@@ -1,6 +1,7 @@
 //! `bearingd run`: the service. With no config, the embedded default: a simulated sensor that
 //! develops an outer-race fault after 30 s, so that a new user sees the whole loop.
 
+use super::format::FormatArg;
 use super::CliError;
 use crate::config::{self, Config};
 use crate::daemon::state::StateError;
@@ -37,13 +38,25 @@ pub struct RunArgs {
     /// its config (docs/FLEET.md).
     #[arg(long, value_name = "BROKER")]
     fleet: Option<String>,
+    // With json, the status lines, flags, health changes and the summary are one JSON object
+    // per line on stdout (NDJSON), each with its "type".
+    #[command(flatten)]
+    format: FormatArg,
 }
 
-/// Prints every flag change as it happens.
-struct FlagPrinter;
+/// Prints every flag change as it happens (with `json`, one JSON object per line).
+struct FlagPrinter {
+    json: bool,
+}
 
 impl Sink for FlagPrinter {
     fn write(&mut self, message: &PipelineMessage) {
+        if self.json {
+            if let Some(value) = message_json(message) {
+                println!("{value}");
+            }
+            return;
+        }
         match message {
             PipelineMessage::Flag(f) => println!(
                 "FLAG {}: {} {} -> {} — {} (score {:.1}, {:.1} Hz) at sample {}",
@@ -81,6 +94,37 @@ impl Sink for FlagPrinter {
     fn finish(&mut self) -> Result<(), SinkError> {
         Ok(())
     }
+}
+
+/// A flag change or a health change as a line of `run --format json` (`None`: not printed).
+fn message_json(message: &PipelineMessage) -> Option<serde_json::Value> {
+    match message {
+        PipelineMessage::Flag(f) => Some(typed("flag", f)),
+        PipelineMessage::Detector(m) => m.as_flag().map(|f| {
+            let (from, to) = f.change();
+            serde_json::json!({
+                "type": "flag",
+                "channel": f.channel().to_string(),
+                "flag": f.flag().name,
+                "from": from.to_string(),
+                "to": to.to_string(),
+                "score": f.score(),
+                "evidence": f.evidence(),
+                "end_sample": f.end_sample(),
+            })
+        }),
+        PipelineMessage::Health(h) if h.kind != HealthKind::Bands => Some(typed("health", h)),
+        _ => None,
+    }
+}
+
+/// `value` as a JSON object with `"type": kind` added (a line of `--format json`).
+fn typed(kind: &str, value: &impl serde::Serialize) -> serde_json::Value {
+    let mut value = serde_json::to_value(value).unwrap_or_default();
+    if let Some(object) = value.as_object_mut() {
+        object.insert("type".into(), kind.into());
+    }
+    value
 }
 
 pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
@@ -136,15 +180,20 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         .enable_all()
         .build()
         .map_err(|e| CliError::failure(format!("cannot start the async runtime: {e}")))?;
-    let sinks = SinkPlan::run(vec![Box::new(FlagPrinter)]);
+    let json = args.format.json();
+    let sinks = SinkPlan::run(vec![Box::new(FlagPrinter { json })]);
     let summary = runtime.block_on(async {
         let shutdown = shutdown_signal().map_err(|e| {
             CliError::failure(format!("cannot install the SIGINT/SIGTERM handlers: {e}"))
         })?;
-        run(config, options, sinks, print_events(), shutdown)
+        run(config, options, sinks, print_events(json), shutdown)
             .await
             .map_err(CliError::input)
     })?;
+    if json {
+        println!("{}", typed("summary", &summary));
+        return Ok(());
+    }
     println!(
         "summary: {} messages, {} twin fits ({} dropped), {} alerts published{}",
         summary.messages,
@@ -220,13 +269,17 @@ pub(super) fn embedded_config(data_dir_arg: Option<&Path>) -> Result<Config, Cli
     Config::embedded_in(&data).map_err(CliError::input)
 }
 
-/// The daemon's events as lines: status lines on stdout, everything else on stderr (the
-/// journal under systemd).
-pub(super) fn print_events() -> Events {
-    Arc::new(|event| match event {
+/// The daemon's events as lines: status lines on stdout (with `json`, one JSON object per
+/// channel, `"type": "status"`), everything else on stderr (the journal under systemd).
+pub(super) fn print_events(json: bool) -> Events {
+    Arc::new(move |event| match event {
         DaemonEvent::Status(board) => {
             for channel in &board {
-                println!("{}", status_line(channel));
+                if json {
+                    println!("{}", typed("status", channel));
+                } else {
+                    println!("{}", status_line(channel));
+                }
             }
         }
         other => eprintln!("{}", event_line(&other)),
