@@ -196,6 +196,15 @@ pub fn python_sparkplug() -> Option<PathBuf> {
     )
 }
 
+/// The project's Python, whose standard `pty` module runs a command under a pseudo-terminal
+/// (the progress bars' tests).
+///
+/// # Panics
+/// Under `CI=true` when it is missing (tests only).
+pub fn python_pty() -> Option<PathBuf> {
+    venv_python("import pty", "Python's pty module")
+}
+
 fn venv_python(imports: &str, what: &str) -> Option<PathBuf> {
     let py = repo_root().join(".venv/bin/python");
     let ci = std::env::var("CI").is_ok_and(|v| v == "true");

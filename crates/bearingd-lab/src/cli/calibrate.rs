@@ -13,6 +13,7 @@ use crate::plot::{self, Color, Figure, Series, Shade, SpectrumPanel};
 use crate::recording::read_recording;
 use crate::twin::physics::{calibrate, Calibration, CalibrationSettings, Dof, PhysicsParams};
 use crate::twin::SimulatedFault;
+use bearingd::cli::format::{FormatArg, Remarks};
 use bearingd::cli::{CliError, RecordingArgs};
 use clap::Args;
 use std::path::PathBuf;
@@ -55,6 +56,9 @@ pub struct CalibrateArgs {
     /// Write the calibrated parameters as JSON (for `simulate --model physics --calibrated`).
     #[arg(long)]
     save: Option<PathBuf>,
+    // With json, the result as one JSON document on stdout, the notes and warnings in it.
+    #[command(flatten)]
+    format: FormatArg,
 }
 
 /// The physics twin's defect for an envelope verdict (it has no cage fault).
@@ -100,12 +104,15 @@ pub fn run(args: &CalibrateArgs) -> Result<(), CliError> {
         ..AnalyzeRequest::default()
     };
     let conditions = resolve_conditions(&recording, &request, false).map_err(CliError::input)?;
-    for note in &conditions.notes {
-        eprintln!("bearingd: note: {note}");
-    }
-    for warning in &conditions.warnings {
-        eprintln!("bearingd: warning: {warning}");
-    }
+    let mut remarks = Remarks::new("bearingd", args.format.json());
+    conditions
+        .notes
+        .iter()
+        .for_each(|n| remarks.note(n.as_str()));
+    conditions
+        .warnings
+        .iter()
+        .for_each(|w| remarks.warning(w.as_str()));
     let file = args.file.display().to_string();
     let samples: Vec<f32> = recording.samples.iter().map(|&x| x as f32).collect();
     let freqs = conditions.bearing.fault_frequencies(conditions.rpm / 60.0);
@@ -121,10 +128,15 @@ pub fn run(args: &CalibrateArgs) -> Result<(), CliError> {
         None => match analysis.diagnosis.verdict.fault() {
             Some(kind) => match modelled(kind) {
                 Some(fault) => {
-                    eprintln!(
-                        "bearingd: --fault not given: modelling the envelope diagnosis, {}",
+                    let said = format!(
+                        "--fault not given: modelling the envelope diagnosis, {}",
                         analysis.diagnosis.verdict.name()
                     );
+                    if args.format.json() {
+                        remarks.notes.push(said);
+                    } else {
+                        eprintln!("bearingd: {said}");
+                    }
                     fault
                 }
                 None => {
@@ -184,7 +196,26 @@ pub fn run(args: &CalibrateArgs) -> Result<(), CliError> {
     })
     .map_err(|e| CliError::input(format!("{file}: {e}")))?;
     let seconds = started.elapsed().as_secs_f64();
-    print_result(&file, &calibration, &base, seconds);
+    if args.format.json() {
+        println!(
+            "{}",
+            serde_json::json!({
+                "file": file,
+                "band_hz": [calibration.band.lo_hz, calibration.band.hi_hz],
+                "evaluations": calibration.evaluations,
+                "generations": calibration.generations,
+                "seconds": seconds,
+                "params": calibration.params,
+                "error_db": calibration.error_db,
+                "initial_error_db": calibration.initial_error_db,
+                "noise_floor_g_per_sqrt_hz": calibration.noise_floor_g_per_sqrt_hz,
+                "notes": remarks.notes,
+                "warnings": remarks.warnings,
+            })
+        );
+    } else {
+        print_result(&file, &calibration, &base, seconds);
+    }
     if let Some(path) = &args.plot {
         plot::save(&figure(&file, &calibration), path)
             .map_err(|e| CliError::failure(e.to_string()))?;

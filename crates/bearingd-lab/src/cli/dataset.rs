@@ -2,17 +2,19 @@
 //! diagnosis (see [`crate::twin::dataset`]): `dataset.npz` (NumPy: `x` records × samples in
 //! g, `y` labels, and the drawn conditions), `manifest.csv` (one row per record, with its class
 //! name), a copy of the spec, and with `--mcap` each record as a self-describing raw MCAP log
-//! that `bearingd replay` reads as the daemon's own. Records are made on all cores, with a
-//! progress bar on a terminal.
+//! that `bearingd replay` reads as the daemon's own. Records are made on all cores, with
+//! progress on stderr ([`Progress`]).
 
+use super::progress::Progress;
 use crate::sinks::mcap::raw_log::{write_raw_log, LogSignal, RawLog};
 use crate::twin::dataset::{DatasetRecord, DatasetSpec};
+use bearingd::cli::format::FormatArg;
 use bearingd::cli::import::raw_log_error;
 use bearingd::cli::CliError;
 use clap::Args;
 use ndarray::{Array1, Array2};
 use rayon::prelude::*;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -33,6 +35,8 @@ pub struct DatasetArgs {
     /// set says the bearing used.
     #[arg(long)]
     bearing: Option<String>,
+    #[command(flatten)]
+    format: FormatArg,
 }
 
 pub fn run(args: &DatasetArgs) -> Result<(), CliError> {
@@ -67,15 +71,13 @@ pub fn run(args: &DatasetArgs) -> Result<(), CliError> {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| CliError::input(format!("{}: cannot create: {e}", args.out.display())))?;
     let records = spec.records();
-    let bar = progress_bar(records.len() as u64);
+    let progress = Progress::start("dataset", "records", records.len() as u64);
     let started = std::time::Instant::now();
     let made: Vec<Vec<f32>> = records
         .par_iter()
         .map(|record| {
             let samples = spec.generate(record);
-            if let Some(bar) = &bar {
-                bar.inc(1);
-            }
+            progress.inc("");
             samples.map_err(|e| {
                 CliError::input(format!(
                     "record {} ({}): {e}",
@@ -85,9 +87,7 @@ pub fn run(args: &DatasetArgs) -> Result<(), CliError> {
             })
         })
         .collect::<Result<_, _>>()?;
-    if let Some(bar) = &bar {
-        bar.finish_and_clear();
-    }
+    progress.finish("");
     let generated_s = started.elapsed().as_secs_f64();
     write_npz(&args.out.join("dataset.npz"), &records, &made, &spec)?;
     write_manifest(&args.out.join("manifest.csv"), &records, args.mcap)?;
@@ -96,6 +96,24 @@ pub fn run(args: &DatasetArgs) -> Result<(), CliError> {
         .map_err(|e| CliError::failure(format!("{}: cannot write: {e}", copy.display())))?;
     if args.mcap {
         write_logs(&args.out, &spec, &records, &made)?;
+    }
+    if args.format.json() {
+        println!(
+            "{}",
+            serde_json::json!({
+                "records": records.len(),
+                "classes": spec.faults.len(),
+                "records_per_class": spec.records_per_fault,
+                "duration_s": spec.duration_s,
+                "fs_hz": spec.fs_hz,
+                "model": spec.model.name(),
+                "generated_s": generated_s,
+                "threads": rayon::current_num_threads(),
+                "out": args.out.display().to_string(),
+                "mcap": args.mcap,
+            })
+        );
+        return Ok(());
     }
     eprintln!(
         "bearingd: dataset: {} records ({} classes × {}, {} s at {} Hz, {} model) made in {generated_s:.1} s on {} threads; wrote {}/dataset.npz and manifest.csv{}",
@@ -110,17 +128,6 @@ pub fn run(args: &DatasetArgs) -> Result<(), CliError> {
         if args.mcap { " and mcap/" } else { "" }
     );
     Ok(())
-}
-
-fn progress_bar(records: u64) -> Option<indicatif::ProgressBar> {
-    if !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = indicatif::ProgressBar::new(records);
-    let style = indicatif::ProgressStyle::with_template("dataset {bar:20} {pos}/{len} ({eta})")
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar());
-    bar.set_style(style);
-    Some(bar)
 }
 
 /// `x` (records × samples, float32 g), `y` (labels, int64), and per record `rpm`, `noise_g`,

@@ -3,6 +3,7 @@
 //! through the daemon's replay; with `--false-alarm-hours`, hours of healthy signal through the
 //! daemon's channel monitor (see `crate::evaluate` and docs/DIAGNOSIS.md).
 
+use super::progress::Progress;
 use crate::evaluate::false_alarms::{
     render_false_alarms, stream_run, summarize_false_alarms, FalseAlarmPlan, FalseAlarmSummary,
     RunResult,
@@ -16,11 +17,11 @@ use crate::evaluate::{
     Path as JudgedPath, Summary, Sweep,
 };
 use crate::twin::Nuisance;
+use bearingd::cli::format::FormatArg;
 use bearingd::cli::CliError;
 use clap::Args;
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -78,6 +79,10 @@ pub struct EvaluateArgs {
     /// gear and electrical tones): bearing, 1× tone and white noise only.
     #[arg(long)]
     no_nuisance: bool,
+    // With json, the summary and the files written as one JSON document on stdout instead of
+    // the tables.
+    #[command(flatten)]
+    format: FormatArg,
 }
 
 /// What results.json holds.
@@ -113,27 +118,16 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
         sweep.name, sweep.monitor_s, sweep.seed
     );
     let started = Instant::now();
-    let terminal = std::io::stderr().is_terminal();
-    let progress = |done: usize, total: usize| {
-        let elapsed = started.elapsed().as_secs_f64();
-        if terminal {
-            let left = elapsed / done as f64 * (total - done) as f64;
-            eprint!(
-                "\revaluate: {done}/{total} runs ({:.0} %), {elapsed:.0} s, ~{left:.0} s left   ",
-                100.0 * done as f64 / total as f64
-            );
-            let _ = std::io::stderr().flush();
-        } else if done == total || (done * 4 / total) != ((done - 1) * 4 / total) {
-            eprintln!("evaluate: {done}/{total} runs, {elapsed:.0} s");
-        }
-    };
-    let results = run_sweep(&bench, &sweep, threads, &progress);
-    if terminal {
-        eprintln!();
-    }
+    let progress = Progress::start("evaluate", "runs", total as u64);
+    let step = |done: usize, _total: usize| progress.set(done as u64, "");
+    let results = run_sweep(&bench, &sweep, threads, &step);
+    progress.finish("");
     let summary = summarize(&results);
     let tables = render_tables(&summary);
-    print!("{tables}");
+    let text = !args.format.json();
+    if text {
+        print!("{tables}");
+    }
 
     let write = |name: &str, bytes: &[u8]| write_out(&args.out, name, bytes);
     let json = serde_json::to_vec_pretty(&ResultsFile {
@@ -149,12 +143,18 @@ pub fn run(args: &EvaluateArgs) -> Result<(), CliError> {
     ];
     if bench.witness.is_some() {
         let grid = crate::evaluate::agreement::render(&results);
-        print!("\n{grid}");
+        if text {
+            print!("\n{grid}");
+        }
         written.push(write("agreement_grid.txt", grid.as_bytes())?);
     }
     let plot_path = args.out.join("pd_vs_snr.svg");
     crate::plot::save(&pd_figure(&summary, &sweep.name), &plot_path)
         .map_err(|e| CliError::failure(e.to_string()))?;
+    if !text {
+        written.push(plot_path);
+        return print_json(&sweep.name, &summary, started, &written);
+    }
     eprintln!(
         "evaluate: {} runs in {:.1} s; wrote {}, {}",
         results.len(),
@@ -179,16 +179,21 @@ fn bench(args: &EvaluateArgs) -> Result<Bench, CliError> {
     }
 }
 
-/// A progress bar on a terminal (`None` elsewhere: the caller prints lines).
-fn progress_bar(total: u64, template: &str) -> Option<indicatif::ProgressBar> {
-    std::io::stderr().is_terminal().then(|| {
-        let bar = indicatif::ProgressBar::new(total);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(template)
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar
-    })
+/// `evaluate --format json`: what the tables say, as one JSON document on stdout.
+fn print_json(
+    kind: &str,
+    summary: &impl Serialize,
+    started: Instant,
+    written: &[PathBuf],
+) -> Result<(), CliError> {
+    let json = serde_json::json!({
+        "evaluation": kind,
+        "seconds": started.elapsed().as_secs_f64(),
+        "summary": summary,
+        "written": written,
+    });
+    println!("{json}");
+    Ok(())
 }
 
 /// What false_alarms.json holds.
@@ -228,29 +233,19 @@ fn run_false_alarms(args: &EvaluateArgs, bench: &Bench, hours: f64) -> Result<()
     );
     let started = Instant::now();
     let cpu_at_start = process_cpu_s();
-    let bar = progress_bar(
-        runs.len() as u64,
-        "evaluate {bar:20} {pos}/{len} runs ({eta}) {wide_msg}",
-    );
+    let bar = Progress::start("evaluate", "runs", runs.len() as u64);
     let simulated = std::sync::Mutex::new((0.0f64, 0usize));
-    let progress = |done: usize, total: usize, result: &RunResult| {
+    let progress = |done: usize, _total: usize, result: &RunResult| {
         let (hours, rises) = {
             let mut seen = simulated.lock().unwrap_or_else(|e| e.into_inner());
             seen.0 += result.run.seconds / 3600.0;
             seen.1 += result.rises.len();
             *seen
         };
-        let line = format!("{hours:.1} h simulated, {rises} flag rise(s)");
-        match &bar {
-            Some(bar) => {
-                bar.set_position(done as u64);
-                bar.set_message(line);
-            }
-            None if done == total || (done * 4 / total) != ((done - 1) * 4 / total) => {
-                eprintln!("evaluate: {done}/{total} runs, {line}");
-            }
-            None => {}
-        }
+        bar.set(
+            done as u64,
+            &format!("{hours:.1} h simulated, {rises} flag rise(s)"),
+        );
     };
     let results = in_order(
         &runs,
@@ -259,9 +254,7 @@ fn run_false_alarms(args: &EvaluateArgs, bench: &Bench, hours: f64) -> Result<()
         |(), run| stream_run(bench, &plan, run),
         &progress,
     );
-    if let Some(bar) = &bar {
-        bar.finish_and_clear();
-    }
+    bar.finish("");
     let wall_s = started.elapsed().as_secs_f64();
     let cpu_s = process_cpu_s()
         .zip(cpu_at_start)
@@ -277,7 +270,9 @@ fn run_false_alarms(args: &EvaluateArgs, bench: &Bench, hours: f64) -> Result<()
             summary.all.hours / (cpu / 60.0).max(1e-9)
         ))
     );
-    print!("{table}");
+    if !args.format.json() {
+        print!("{table}");
+    }
     let json = serde_json::to_vec_pretty(&FalseAlarmsFile {
         plan: &plan,
         summary: &summary,
@@ -290,6 +285,9 @@ fn run_false_alarms(args: &EvaluateArgs, bench: &Bench, hours: f64) -> Result<()
         write_out(&args.out, "false_alarms.json", &json)?,
         write_out(&args.out, "false_alarms.txt", table.as_bytes())?,
     ];
+    if args.format.json() {
+        return print_json("false alarms", &summary, started, &written);
+    }
     eprintln!(
         "evaluate: wrote {} and {}",
         display(&written[0]),
@@ -377,11 +375,8 @@ fn run_recordings(args: &EvaluateArgs) -> Result<(), CliError> {
         options.jobs
     );
     let started = Instant::now();
-    let bar = progress_bar(
-        tasks.len() as u64,
-        "evaluate {bar:20} {pos}/{len} ({eta}) {wide_msg}",
-    );
-    let progress = |done: usize, total: usize, entry: &Entry| {
+    let bar = Progress::start("evaluate", "record·channel runs", tasks.len() as u64);
+    let progress = |done: usize, _total: usize, entry: &Entry| {
         let said = |path| Said::of(path, entry).name();
         let line = format!(
             "{}: analyze {}, daemon {}",
@@ -389,21 +384,15 @@ fn run_recordings(args: &EvaluateArgs) -> Result<(), CliError> {
             said(JudgedPath::Record),
             said(JudgedPath::Monitor)
         );
-        match &bar {
-            Some(bar) => {
-                bar.set_position(done as u64);
-                bar.set_message(line);
-            }
-            None => eprintln!("evaluate: {done}/{total} {line}"),
-        }
+        bar.set(done as u64, &line);
     };
     let entries = evaluate_recordings(&tasks, &options, &progress);
-    if let Some(bar) = &bar {
-        bar.finish_and_clear();
-    }
+    bar.finish("");
     let counted = tally(&entries);
     let table = render_recordings(&counted);
-    print!("{table}");
+    if !args.format.json() {
+        print!("{table}");
+    }
     let json = RecordingsReport {
         manifests: &args.recordings,
         all_channels: args.all_channels,
@@ -416,13 +405,17 @@ fn run_recordings(args: &EvaluateArgs) -> Result<(), CliError> {
         write_out(&args.out, "recordings.json", &json)?,
         write_out(&args.out, "recordings.txt", table.as_bytes())?,
     ];
-    eprintln!(
-        "evaluate: {} record·channel runs in {:.1} s; wrote {} and {}",
-        entries.len(),
-        started.elapsed().as_secs_f64(),
-        display(&written[0]),
-        display(&written[1])
-    );
+    if args.format.json() {
+        print_json("recordings", &counted, started, &written)?;
+    } else {
+        eprintln!(
+            "evaluate: {} record·channel runs in {:.1} s; wrote {} and {}",
+            entries.len(),
+            started.elapsed().as_secs_f64(),
+            display(&written[0]),
+            display(&written[1])
+        );
+    }
     if args.strict && counted.problems() > 0 {
         return Err(CliError::failure(format!(
             "--strict: {} confident-wrong answer(s) (analyze {}, daemon {}), {} disagreement(s), \

@@ -7,6 +7,7 @@ mod calibrate;
 mod dataset;
 pub mod docs;
 mod evaluate;
+mod progress;
 mod simulate;
 mod train;
 mod trend;

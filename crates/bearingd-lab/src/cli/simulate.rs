@@ -3,14 +3,16 @@
 //! ringing a resonance, MODELS.md §4) or from the physics twin (the 6-DOF contact model,
 //! MODELS.md §5, optionally with parameters calibrated to a real machine).
 
+use super::progress::Progress;
 use super::twin_args::{DofArg, FaultArg, MachineFaultArg};
 use crate::bearing::BearingGeometry;
 use crate::machine_fault::MachineFault;
 use crate::twin::physics::{PhysicsModel, PhysicsParams};
 use crate::twin::{Nuisance, SimulationParams, Simulator};
+use bearingd::cli::format::FormatArg;
 use bearingd::cli::CliError;
 use clap::{Args, ValueEnum};
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -103,6 +105,8 @@ pub struct SimulateArgs {
     /// Random seed: the same seed gives the same record.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    #[command(flatten)]
+    format: FormatArg,
 }
 
 fn parse_seconds(text: &str) -> Option<f64> {
@@ -215,16 +219,36 @@ pub fn run(args: &SimulateArgs) -> Result<(), CliError> {
         }
     };
     written.map_err(|e| CliError::failure(format!("{}: cannot write: {e}", args.out.display())))?;
-    eprintln!(
-        "wrote {} samples ({duration} s at {} Hz) to {}; analyse with: bearingd analyze {}{} --rpm {} --bearing {}",
-        samples.len(),
-        args.fs,
+    let analyze = format!(
+        "bearingd analyze {}{} --rpm {} --bearing {}",
         args.out.display(),
-        args.out.display(),
-        if extension.as_deref() == Some("csv") { format!(" --fs {}", args.fs) } else { String::new() },
+        if extension.as_deref() == Some("csv") {
+            format!(" --fs {}", args.fs)
+        } else {
+            String::new()
+        },
         args.rpm,
         args.bearing
     );
+    if args.format.json() {
+        println!(
+            "{}",
+            serde_json::json!({
+                "samples": samples.len(),
+                "duration_s": duration,
+                "fs_hz": args.fs,
+                "out": args.out.display().to_string(),
+                "analyze": analyze,
+            })
+        );
+    } else {
+        eprintln!(
+            "wrote {} samples ({duration} s at {} Hz) to {}; analyse with: {analyze}",
+            samples.len(),
+            args.fs,
+            args.out.display(),
+        );
+    }
     Ok(())
 }
 
@@ -280,24 +304,14 @@ fn simulate_physics(
     let total = params.samples();
     let mut model = PhysicsModel::new(params).map_err(CliError::input)?;
     let mut samples = vec![0f32; total];
-    // Progress on a terminal only (a log or a pipe gets the one summary line).
-    let show_progress = std::io::stderr().is_terminal();
-    let started = std::time::Instant::now();
+    // One block per second of signal: progress counts the seconds simulated.
     let block = (args.fs as usize).max(1);
-    for (i, chunk) in samples.chunks_mut(block).enumerate() {
+    let progress = Progress::start("simulate", "s of signal", total.div_ceil(block) as u64);
+    for chunk in samples.chunks_mut(block) {
         model.fill(chunk).map_err(CliError::failure)?;
-        if show_progress {
-            let done = ((i + 1) * block).min(total);
-            eprint!(
-                "\rbearingd: physics twin: {:.1} of {duration} s simulated ({:.1} s elapsed)",
-                done as f64 / args.fs,
-                started.elapsed().as_secs_f64()
-            );
-        }
+        progress.inc("physics twin");
     }
-    if show_progress {
-        eprintln!();
-    }
+    progress.finish("physics twin");
     Ok(samples)
 }
 

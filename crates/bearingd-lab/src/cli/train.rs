@@ -3,6 +3,7 @@
 //! accuracies, and writes the model file (weights and model card).
 
 use crate::learned::{train, FeatureSettings, TrainingSet, TrainingSettings};
+use bearingd::cli::format::FormatArg;
 use bearingd::cli::CliError;
 use clap::Args;
 use std::path::PathBuf;
@@ -28,6 +29,10 @@ pub struct TrainArgs {
     /// on data sets of many, e.g. `bearing = "random"`).
     #[arg(long, value_enum, default_value_t = Axis::Shaft)]
     axis: Axis,
+    // With json, the summary and every epoch as one JSON document on stdout (the epochs are
+    // still printed on stderr as they end).
+    #[command(flatten)]
+    format: FormatArg,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -62,7 +67,14 @@ pub fn run(args: &TrainArgs) -> Result<(), CliError> {
         seed: args.seed,
         ..TrainingSettings::default()
     };
+    let mut epochs = Vec::new();
     let trained = train(&set, &settings, |epoch| {
+        epochs.push(serde_json::json!({
+            "epoch": epoch.epoch,
+            "loss": epoch.loss,
+            "train_accuracy": epoch.train_accuracy,
+            "validation_accuracy": epoch.validation_accuracy,
+        }));
         eprintln!(
             "epoch {:>3}/{}: loss {:.4}, training accuracy {:.3}, held-out accuracy {:.3} ({:.0} s)",
             epoch.epoch,
@@ -75,6 +87,21 @@ pub fn run(args: &TrainArgs) -> Result<(), CliError> {
     })
     .map_err(CliError::failure)?;
     trained.save(&args.out).map_err(CliError::failure)?;
+    if args.format.json() {
+        println!(
+            "{}",
+            serde_json::json!({
+                "records": set.records,
+                "segments": set.segments(),
+                "classes": set.spec.faults.iter().map(|f| f.name()).collect::<Vec<_>>(),
+                "epochs": epochs,
+                "validation_accuracy": trained.last_epoch.validation_accuracy,
+                "seconds": started.elapsed().as_secs_f64(),
+                "out": args.out.display().to_string(),
+            })
+        );
+        return Ok(());
+    }
     eprintln!(
         "bearingd: train: held-out accuracy {:.3} after {} epochs in {:.0} s; wrote {}",
         trained.last_epoch.validation_accuracy,

@@ -8,6 +8,7 @@
 //!
 //! Reading and timing files happens here; the life itself is sans-IO ([`LifeTracker`]).
 
+use super::progress::Progress;
 use crate::analysis::health::CONFIRM_WINDOWS;
 use crate::evaluate::recordings::Manifest;
 use crate::life::{hindsight, HwFrom, LifeSettings, LifeTracker, SnapshotHw};
@@ -18,24 +19,12 @@ use crate::recording::{
 use crate::report::{
     life_figure, render_life_text, LifeGap, LifeReport, LifeSettingsReport, SkippedFile,
 };
+use bearingd::cli::format::ReportFormat;
 use bearingd::cli::{CliError, RecordingArgs};
 use bearingd::mcap_log::read_header;
-use clap::{Args, ValueEnum};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use clap::Args;
 use std::collections::{BTreeSet, HashMap};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
-use std::time::Instant;
-
-#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum TrendFormat {
-    /// The stage timeline and the trend, for people.
-    Text,
-    /// Everything, per snapshot, as one JSON document.
-    Json,
-    /// One Markdown table row per snapshot.
-    Table,
-}
 
 #[derive(Args)]
 pub struct TrendArgs {
@@ -46,7 +35,7 @@ pub struct TrendArgs {
     recording: RecordingArgs,
     /// Output format.
     #[arg(long, value_enum, default_value = "text")]
-    format: TrendFormat,
+    format: ReportFormat,
     /// Draw the stage timeline (RMS with the trend, kurtosis, HW residual, fault score) to
     /// this file (.png or .svg).
     #[arg(long)]
@@ -122,9 +111,9 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
     let mut clock = LogClock::default();
     let mut hw_note = HwNote::default();
     let manifest = ManifestSpeeds::find(&args.path);
-    let progress = Progress::start(placed.len());
+    let progress = Progress::start("trend", "files", placed.len() as u64);
     for (done, file) in placed.iter().enumerate() {
-        progress.step(done, points.len());
+        progress.set(done as u64, &format!("{} snapshots", points.len()));
         let name = file_label(&file.path);
         let (recording, placement) =
             match read_recording_placed(&file.path, &args.recording.read_options()) {
@@ -213,7 +202,9 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
             }
         }
     }
-    progress.finish(placed.len(), points.len());
+    let snapshots = format!("{} snapshots", points.len());
+    progress.set(placed.len() as u64, &snapshots);
+    progress.finish(&snapshots);
     if points.is_empty() {
         let mut message = format!("{}: no usable snapshot", args.path.display());
         for s in &skipped {
@@ -250,14 +241,14 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
         crate::plot::save(&life_figure(&report), plot).map_err(CliError::input)?;
     }
     match args.format {
-        TrendFormat::Text => print!("{}", render_life_text(&report)),
-        TrendFormat::Json => println!(
+        ReportFormat::Text => print!("{}", render_life_text(&report)),
+        ReportFormat::Json => println!(
             "{}",
             serde_json::to_string_pretty(&report).map_err(CliError::failure)?
         ),
-        TrendFormat::Table => print!("{}", table(&report)),
+        ReportFormat::Table => print!("{}", table(&report)),
     }
-    if !report.skipped.is_empty() && args.format != TrendFormat::Text {
+    if !report.skipped.is_empty() && args.format != ReportFormat::Text {
         eprintln!(
             "bearingd: warning: skipped {} file(s) that could not be used:",
             report.skipped.len()
@@ -511,67 +502,6 @@ impl LogClock {
             ));
         }
         notes
-    }
-}
-
-/// Progress on stderr: a bar on a terminal, plain lines elsewhere (a pipe, a log file), at
-/// each quarter of the files and at least every 10 s.
-struct Progress {
-    bar: Option<ProgressBar>,
-    total: usize,
-    started: Instant,
-    last_line: std::cell::Cell<Instant>,
-}
-
-impl Progress {
-    fn start(total: usize) -> Self {
-        let bar = std::io::stderr().is_terminal().then(|| {
-            let bar = ProgressBar::with_draw_target(
-                Some(total as u64),
-                ProgressDrawTarget::stderr_with_hz(4),
-            );
-            if let Ok(style) =
-                ProgressStyle::with_template("trend {bar:40} {pos}/{len} files, {eta} left")
-            {
-                bar.set_style(style);
-            }
-            bar
-        });
-        let now = Instant::now();
-        Progress {
-            bar,
-            total,
-            started: now,
-            last_line: std::cell::Cell::new(now),
-        }
-    }
-
-    /// `done` files read so far, `snapshots` taken from them.
-    fn step(&self, done: usize, snapshots: usize) {
-        if let Some(bar) = &self.bar {
-            bar.set_position(done as u64);
-            return;
-        }
-        let quarter = done > 0 && done * 4 / self.total != (done - 1) * 4 / self.total;
-        if quarter || self.last_line.get().elapsed().as_secs_f64() >= 10.0 {
-            self.line(done, snapshots);
-        }
-    }
-
-    fn finish(&self, done: usize, snapshots: usize) {
-        match &self.bar {
-            Some(bar) => bar.finish_and_clear(),
-            None => self.line(done, snapshots),
-        }
-    }
-
-    fn line(&self, done: usize, snapshots: usize) {
-        eprintln!(
-            "trend: {done}/{} files, {snapshots} snapshots, {:.1} s",
-            self.total,
-            self.started.elapsed().as_secs_f64()
-        );
-        self.last_line.set(Instant::now());
     }
 }
 
