@@ -61,6 +61,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd-lab' -ScriptBlock {
             [CompletionResult]::new('--machine-fault-velocity', '--machine-fault-velocity', [CompletionResultType]::ParameterName, 'RMS velocity of the machine fault''s 1× line, mm/s')
             [CompletionResult]::new('--onset', '--onset', [CompletionResultType]::ParameterName, 'Signal model: the fault appears at this time, s')
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Random seed: the same seed gives the same record')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--nuisance', '--nuisance', [CompletionResultType]::ParameterName, 'Signal model: add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md)')
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
@@ -70,9 +71,10 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd-lab' -ScriptBlock {
             [CompletionResult]::new('--spec', '--spec', [CompletionResultType]::ParameterName, 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml')
             [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/')
             [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Simulate this bearing instead of the spec''s `bearing`: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or a custom geometry. One spec makes the training set of every bearing''s model; the spec.toml written beside the set says the bearing used')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--mcap', '--mcap', [CompletionResultType]::ParameterName, 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd-lab;train' {
@@ -81,8 +83,9 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd-lab' -ScriptBlock {
             [CompletionResult]::new('--epochs', '--epochs', [CompletionResultType]::ParameterName, 'Passes over the training segments')
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'The seed of the initial weights, the corruption noise and the batch order')
             [CompletionResult]::new('--axis', '--axis', [CompletionResultType]::ParameterName, 'The input''s axis: `shaft` orders (the model knows the data set''s one bearing) or `fault-relative` orders (each fault''s own; the model serves any bearing, best trained on data sets of many, e.g. `bearing = "random"`)')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd-lab;calibrate' {
@@ -102,6 +105,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd-lab' -ScriptBlock {
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Seed of the search: the same seed gives the same calibration')
             [CompletionResult]::new('--plot', '--plot', [CompletionResultType]::ParameterName, 'Draw the measured, calibrated and default spectra to this file (.png or .svg)')
             [CompletionResult]::new('--save', '--save', [CompletionResultType]::ParameterName, 'Write the calibrated parameters as JSON (for `simulate --model physics --calibrated`)')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
@@ -113,12 +117,13 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd-lab' -ScriptBlock {
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Seed of the sweep: the same seed gives the same records and results')
             [CompletionResult]::new('--jobs', '--jobs', [CompletionResultType]::ParameterName, 'Worker threads (default: the machine''s cores)')
             [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'Take the analysis and threshold settings from this config file instead of the embedded default (to evaluate a tuned configuration). With `twin.learned_model` the sweep''s record path also writes agreement_grid.txt (the learned model''s agreement decided at every point of a parameter grid); with --recordings only its agreement_* keys and model are used, by both paths')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--all-channels', '--all-channels', [CompletionResultType]::ParameterName, 'With --recordings: also the other channels of each record (CWRU fan end and base, every axis of other files; IMS snapshots are always evaluated on all eight)')
             [CompletionResult]::new('--strict', '--strict', [CompletionResultType]::ParameterName, 'With --recordings: exit 1 if any answer is confident and wrong, the paths disagree on any record, or any record fails (CI)')
             [CompletionResult]::new('--quick', '--quick', [CompletionResultType]::ParameterName, 'The small sweep CI runs (both bearings at nominal speed, default severity, the simulator''s default noise and 0 dB SNR, healthy records) instead of the full one')
             [CompletionResult]::new('--no-nuisance', '--no-nuisance', [CompletionResultType]::ParameterName, 'Leave out the machine''s nuisance (shaft harmonics, modulated noise, random impulses, gear and electrical tones): bearing, 1× tone and white noise only')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd-lab;trend' {

@@ -74,10 +74,11 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--duration', '--duration', [CompletionResultType]::ParameterName, 'Stop after this many seconds of sample time (default: run until SIGINT/SIGTERM)')
             [CompletionResult]::new('--data-dir', '--data-dir', [CompletionResultType]::ParameterName, 'Where to keep state (DIR/state) and logs (DIR/mcap); overrides outputs.state_dir and outputs.mcap_dir of --config. Without --config, default ./bearingd-data')
             [CompletionResult]::new('--fleet', '--fleet', [CompletionResultType]::ParameterName, 'Also publish to this MQTT broker (mqtt://HOST:PORT or mqtts://HOST:PORT) with the fleet bridge''s defaults, node id = this host''s name: a first look; a service sets [fleet] in its config (docs/FLEET.md)')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--fast', '--fast', [CompletionResultType]::ParameterName, 'Run simulated sensors as fast as the analysis allows instead of in real time')
             [CompletionResult]::new('--quiet', '--quiet', [CompletionResultType]::ParameterName, 'No status lines (flags and the summary are still printed)')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;import' {
@@ -89,6 +90,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"')
             [CompletionResult]::new('--unit', '--unit', [CompletionResultType]::ParameterName, 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s')
             [CompletionResult]::new('--sensor', '--sensor', [CompletionResultType]::ParameterName, 'Sensor id in the log')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
@@ -97,15 +99,17 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'Analyse with this configuration instead of the one the log was recorded with (needed for logs without it: older files, `bearingd import`)')
             [CompletionResult]::new('--speed', '--speed', [CompletionResultType]::ParameterName, 'Replay speed: 1 = real time; default: as fast as possible')
             [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Directory of the replay''s own MCAP log')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--quiet', '--quiet', [CompletionResultType]::ParameterName, 'No progress (neither the bar on a terminal nor the lines elsewhere)')
-            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'Print the summary as JSON (flags with their sample times)')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'The same as --format json')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;validate' {
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;ingest' {
@@ -126,20 +130,22 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--expect-malformed', '--expect-malformed', [CompletionResultType]::ParameterName, 'Expect exactly N malformed frames in total')
             [CompletionResult]::new('--expect-restarts', '--expect-restarts', [CompletionResultType]::ParameterName, 'Expect exactly N restarts in total (one per restarted stream)')
             [CompletionResult]::new('--expect-sensor-lost', '--expect-sensor-lost', [CompletionResultType]::ParameterName, 'Expect exactly N sensor-lost reports in total (a sender that stops is lost once)')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--block-when-full', '--block-when-full', [CompletionResultType]::ParameterName, 'iceoryx2: when the hand-off queue is full, wait (push back into iceoryx2) instead of dropping the oldest batch')
-            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'Print the report as JSON')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'The same as --format json')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;alerts' {
             [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'The daemon''s config file (for its alert service and iceoryx2 root); without it, those of `bearingd run` without a config')
             [CompletionResult]::new('--data-dir', '--data-dir', [CompletionResultType]::ParameterName, 'The `--data-dir` of a `bearingd run` without a config (default ./bearingd-data)')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--count', '--count', [CompletionResultType]::ParameterName, 'Exit after this many alerts (the active alerts printed at start count)')
             [CompletionResult]::new('--timeout', '--timeout', [CompletionResultType]::ParameterName, 'Stop after this many seconds; with --count, an exit status of 1 if fewer came')
-            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'One JSON object per line instead of text')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--json', '--json', [CompletionResultType]::ParameterName, 'The same as --format json')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;fleet-decode' {
@@ -151,17 +157,18 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
         'bearingd;config' {
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
             [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor)')
+            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor); with --format json, the same settings as one JSON document (without the comments)')
             [CompletionResult]::new('help', 'help', [CompletionResultType]::ParameterValue, 'Print this message or the help of the given subcommand(s)')
             break
         }
         'bearingd;config;default' {
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;config;help' {
-            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor)')
+            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor); with --format json, the same settings as one JSON document (without the comments)')
             [CompletionResult]::new('help', 'help', [CompletionResultType]::ParameterValue, 'Print this message or the help of the given subcommand(s)')
             break
         }
@@ -200,6 +207,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--machine-fault-velocity', '--machine-fault-velocity', [CompletionResultType]::ParameterName, 'RMS velocity of the machine fault''s 1× line, mm/s')
             [CompletionResult]::new('--onset', '--onset', [CompletionResultType]::ParameterName, 'Signal model: the fault appears at this time, s')
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Random seed: the same seed gives the same record')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--nuisance', '--nuisance', [CompletionResultType]::ParameterName, 'Signal model: add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md)')
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
@@ -209,9 +217,10 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--spec', '--spec', [CompletionResultType]::ParameterName, 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml')
             [CompletionResult]::new('--out', '--out', [CompletionResultType]::ParameterName, 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/')
             [CompletionResult]::new('--bearing', '--bearing', [CompletionResultType]::ParameterName, 'Simulate this bearing instead of the spec''s `bearing`: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or a custom geometry. One spec makes the training set of every bearing''s model; the spec.toml written beside the set says the bearing used')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--mcap', '--mcap', [CompletionResultType]::ParameterName, 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;train' {
@@ -220,8 +229,9 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--epochs', '--epochs', [CompletionResultType]::ParameterName, 'Passes over the training segments')
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'The seed of the initial weights, the corruption noise and the batch order')
             [CompletionResult]::new('--axis', '--axis', [CompletionResultType]::ParameterName, 'The input''s axis: `shaft` orders (the model knows the data set''s one bearing) or `fault-relative` orders (each fault''s own; the model serves any bearing, best trained on data sets of many, e.g. `bearing = "random"`)')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;calibrate' {
@@ -241,6 +251,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Seed of the search: the same seed gives the same calibration')
             [CompletionResult]::new('--plot', '--plot', [CompletionResultType]::ParameterName, 'Draw the measured, calibrated and default spectra to this file (.png or .svg)')
             [CompletionResult]::new('--save', '--save', [CompletionResultType]::ParameterName, 'Write the calibrated parameters as JSON (for `simulate --model physics --calibrated`)')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
@@ -252,12 +263,13 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             [CompletionResult]::new('--seed', '--seed', [CompletionResultType]::ParameterName, 'Seed of the sweep: the same seed gives the same records and results')
             [CompletionResult]::new('--jobs', '--jobs', [CompletionResultType]::ParameterName, 'Worker threads (default: the machine''s cores)')
             [CompletionResult]::new('--config', '--config', [CompletionResultType]::ParameterName, 'Take the analysis and threshold settings from this config file instead of the embedded default (to evaluate a tuned configuration). With `twin.learned_model` the sweep''s record path also writes agreement_grid.txt (the learned model''s agreement decided at every point of a parameter grid); with --recordings only its agreement_* keys and model are used, by both paths')
+            [CompletionResult]::new('--format', '--format', [CompletionResultType]::ParameterName, 'Output format')
             [CompletionResult]::new('--all-channels', '--all-channels', [CompletionResultType]::ParameterName, 'With --recordings: also the other channels of each record (CWRU fan end and base, every axis of other files; IMS snapshots are always evaluated on all eight)')
             [CompletionResult]::new('--strict', '--strict', [CompletionResultType]::ParameterName, 'With --recordings: exit 1 if any answer is confident and wrong, the paths disagree on any record, or any record fails (CI)')
             [CompletionResult]::new('--quick', '--quick', [CompletionResultType]::ParameterName, 'The small sweep CI runs (both bearings at nominal speed, default severity, the simulator''s default noise and 0 dB SNR, healthy records) instead of the full one')
             [CompletionResult]::new('--no-nuisance', '--no-nuisance', [CompletionResultType]::ParameterName, 'Leave out the machine''s nuisance (shaft harmonics, modulated noise, random impulses, gear and electrical tones): bearing, 1× tone and white noise only')
-            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help')
-            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help')
+            [CompletionResult]::new('-h', '-h', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
+            [CompletionResult]::new('--help', '--help', [CompletionResultType]::ParameterName, 'Print help (see more with ''--help'')')
             break
         }
         'bearingd;trend' {
@@ -326,7 +338,7 @@ Register-ArgumentCompleter -Native -CommandName 'bearingd' -ScriptBlock {
             break
         }
         'bearingd;help;config' {
-            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor)')
+            [CompletionResult]::new('default', 'default', [CompletionResultType]::ParameterValue, 'Print the documented default configuration (the embedded default: a simulated sensor); with --format json, the same settings as one JSON document (without the comments)')
             break
         }
         'bearingd;help;config;default' {

@@ -57,6 +57,7 @@ set edit:completion:arg-completer[bearingd-lab] = {|@words|
             cand --machine-fault-velocity 'RMS velocity of the machine fault''s 1× line, mm/s'
             cand --onset 'Signal model: the fault appears at this time, s'
             cand --seed 'Random seed: the same seed gives the same record'
+            cand --format 'Output format'
             cand --nuisance 'Signal model: add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md)'
             cand -h 'Print help (see more with ''--help'')'
             cand --help 'Print help (see more with ''--help'')'
@@ -65,9 +66,10 @@ set edit:completion:arg-completer[bearingd-lab] = {|@words|
             cand --spec 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml'
             cand --out 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/'
             cand --bearing 'Simulate this bearing instead of the spec''s `bearing`: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or a custom geometry. One spec makes the training set of every bearing''s model; the spec.toml written beside the set says the bearing used'
+            cand --format 'Output format'
             cand --mcap 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd-lab;train'= {
             cand --dataset 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes, and same bearing on shaft orders), e.g. a signal-model and a physics set'
@@ -75,8 +77,9 @@ set edit:completion:arg-completer[bearingd-lab] = {|@words|
             cand --epochs 'Passes over the training segments'
             cand --seed 'The seed of the initial weights, the corruption noise and the batch order'
             cand --axis 'The input''s axis: `shaft` orders (the model knows the data set''s one bearing) or `fault-relative` orders (each fault''s own; the model serves any bearing, best trained on data sets of many, e.g. `bearing = "random"`)'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand --format 'Output format'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd-lab;calibrate'= {
             cand --channel 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)'
@@ -95,6 +98,7 @@ set edit:completion:arg-completer[bearingd-lab] = {|@words|
             cand --seed 'Seed of the search: the same seed gives the same calibration'
             cand --plot 'Draw the measured, calibrated and default spectra to this file (.png or .svg)'
             cand --save 'Write the calibrated parameters as JSON (for `simulate --model physics --calibrated`)'
+            cand --format 'Output format'
             cand -h 'Print help (see more with ''--help'')'
             cand --help 'Print help (see more with ''--help'')'
         }
@@ -105,12 +109,13 @@ set edit:completion:arg-completer[bearingd-lab] = {|@words|
             cand --seed 'Seed of the sweep: the same seed gives the same records and results'
             cand --jobs 'Worker threads (default: the machine''s cores)'
             cand --config 'Take the analysis and threshold settings from this config file instead of the embedded default (to evaluate a tuned configuration). With `twin.learned_model` the sweep''s record path also writes agreement_grid.txt (the learned model''s agreement decided at every point of a parameter grid); with --recordings only its agreement_* keys and model are used, by both paths'
+            cand --format 'Output format'
             cand --all-channels 'With --recordings: also the other channels of each record (CWRU fan end and base, every axis of other files; IMS snapshots are always evaluated on all eight)'
             cand --strict 'With --recordings: exit 1 if any answer is confident and wrong, the paths disagree on any record, or any record fails (CI)'
             cand --quick 'The small sweep CI runs (both bearings at nominal speed, default severity, the simulator''s default noise and 0 dB SNR, healthy records) instead of the full one'
             cand --no-nuisance 'Leave out the machine''s nuisance (shaft harmonics, modulated noise, random impulses, gear and electrical tones): bearing, 1× tone and white noise only'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd-lab;trend'= {
             cand --channel 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)'

@@ -67,20 +67,26 @@ looseness\t'Many running-speed harmonics and half orders'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l machine-fault-velocity -d 'RMS velocity of the machine fault\'s 1× line, mm/s' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l onset -d 'Signal model: the fault appears at this time, s' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l seed -d 'Random seed: the same seed gives the same record' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l format -d 'Output format' -r -f -a "text\t'Lines for people'
+json\t'JSON on stdout: one document, or one object per line for a stream of events; notes and warnings are in the object'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -l nuisance -d 'Signal model: add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md)'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand simulate" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l spec -d 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l out -d 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l bearing -d 'Simulate this bearing instead of the spec\'s `bearing`: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or a custom geometry. One spec makes the training set of every bearing\'s model; the spec.toml written beside the set says the bearing used' -r
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l format -d 'Output format' -r -f -a "text\t'Lines for people'
+json\t'JSON on stdout: one document, or one object per line for a stream of events; notes and warnings are in the object'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -l mcap -d 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config'
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -s h -l help -d 'Print help'
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand dataset" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -l dataset -d 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes, and same bearing on shaft orders), e.g. a signal-model and a physics set' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -l out -d 'The model file to write (.safetensors)' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -l epochs -d 'Passes over the training segments' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -l seed -d 'The seed of the initial weights, the corruption noise and the batch order' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -l axis -d 'The input\'s axis: `shaft` orders (the model knows the data set\'s one bearing) or `fault-relative` orders (each fault\'s own; the model serves any bearing, best trained on data sets of many, e.g. `bearing = "random"`)' -r -f -a "shaft\t''
 fault-relative\t''"
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -s h -l help -d 'Print help'
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -l format -d 'Output format' -r -f -a "text\t'Lines for people'
+json\t'JSON on stdout: one document, or one object per line for a stream of events; notes and warnings are in the object'"
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand train" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l channel -d 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l column -d 'Column of a CSV table: header name or 1-based index' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l fs -d 'Sample rate in Hz (overrides what the file says)' -r
@@ -104,6 +110,8 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l 
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l seed -d 'Seed of the search: the same seed gives the same calibration' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l plot -d 'Draw the measured, calibrated and default spectra to this file (.png or .svg)' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l save -d 'Write the calibrated parameters as JSON (for `simulate --model physics --calibrated`)' -r -F
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -l format -d 'Output format' -r -f -a "text\t'Lines for people'
+json\t'JSON on stdout: one document, or one object per line for a stream of events; notes and warnings are in the object'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand calibrate" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l recordings -d 'Instead of the simulator: every record of this manifest (CSV with a header: `file` relative to its folder, and `fault`, `note` or `life_frac` for the truth; `channel_var`, `fs_hz`, `rpm`, `bearing_geometry` where the file does not say) through `bearingd analyze` and through `bearingd import` + `replay`; writes recordings.json. May be given several times' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l false-alarm-hours -d 'Instead of the sweep: H hours of healthy simulated signal per machine (the full sweep\'s three machines at 0.6 and 1 × nominal speed, four noise levels, with the nuisance) streamed through the daemon\'s channel monitor; counts the fault flags that rise (false alarms) per hour of operation; writes false_alarms.json and false_alarms.txt. Without a value: 2 h per machine (about 2.5 min of CPU)' -r
@@ -111,11 +119,13 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l o
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l seed -d 'Seed of the sweep: the same seed gives the same records and results' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l jobs -d 'Worker threads (default: the machine\'s cores)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l config -d 'Take the analysis and threshold settings from this config file instead of the embedded default (to evaluate a tuned configuration). With `twin.learned_model` the sweep\'s record path also writes agreement_grid.txt (the learned model\'s agreement decided at every point of a parameter grid); with --recordings only its agreement_* keys and model are used, by both paths' -r -F
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l format -d 'Output format' -r -f -a "text\t'Lines for people'
+json\t'JSON on stdout: one document, or one object per line for a stream of events; notes and warnings are in the object'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l all-channels -d 'With --recordings: also the other channels of each record (CWRU fan end and base, every axis of other files; IMS snapshots are always evaluated on all eight)'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l strict -d 'With --recordings: exit 1 if any answer is confident and wrong, the paths disagree on any record, or any record fails (CI)'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l quick -d 'The small sweep CI runs (both bearings at nominal speed, default severity, the simulator\'s default noise and 0 dB SNR, healthy records) instead of the full one'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -l no-nuisance -d 'Leave out the machine\'s nuisance (shaft harmonics, modulated noise, random impulses, gear and electrical tones): bearing, 1× tone and white noise only'
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -s h -l help -d 'Print help'
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand evaluate" -s h -l help -d 'Print help (see more with \'--help\')'
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l channel -d 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l column -d 'Column of a CSV table: header name or 1-based index' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l fs -d 'Sample rate in Hz (overrides what the file says)' -r
@@ -124,9 +134,9 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l bear
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l unit -d 'Unit of the file\'s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s' -r -f -a "g\t'Acceleration in g'
 m/s2\t'Acceleration in m/s²'
 full-scale\t'Relative amplitudes (fractions of a recorder\'s full scale)'"
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l format -d 'Output format' -r -f -a "text\t'The stage timeline and the trend, for people'
-json\t'Everything, per snapshot, as one JSON document'
-table\t'One Markdown table row per snapshot'"
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l format -d 'Output format' -r -f -a "text\t'Lines for people'
+json\t'JSON on stdout: one document (`analyze` of several records: an array of them)'
+table\t'One Markdown table row per record (per snapshot for `trend`)'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l plot -d 'Draw the stage timeline (RMS with the trend, kurtosis, HW residual, fault score) to this file (.png or .svg)' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l baseline -d 'Snapshots that form the healthy baseline (and the aging baseline of RMS)' -r
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand trend" -l smoothing -d 'Running median over this many snapshots before the tracker (1: none)' -r
@@ -145,9 +155,9 @@ complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l be
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l unit -d 'Unit of the file\'s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s' -r -f -a "g\t'Acceleration in g'
 m/s2\t'Acceleration in m/s²'
 full-scale\t'Relative amplitudes (fractions of a recorder\'s full scale)'"
-complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l format -d 'Output format' -r -f -a "text\t'A few lines per record for people'
-json\t'One JSON document per record (a JSON array for several records)'
-table\t'One Markdown table row per record, for comparing many records'"
+complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l format -d 'Output format' -r -f -a "text\t'Lines for people'
+json\t'JSON on stdout: one document (`analyze` of several records: an array of them)'
+table\t'One Markdown table row per record (per snapshot for `trend`)'"
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l plot -d 'Draw the envelope spectrum and the kurtogram to this file (.png or .svg); with several records, the record\'s file name is added before the extension. Runs in bearingd-lab' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l config -d 'Take the analysis settings from this configuration file\'s [analysis] section, and its twin.learned_model unless --learned is given: the daemon\'s decision, offline' -r -F
 complete -c bearingd-lab -n "__fish_bearingd_lab_using_subcommand analyze" -l band-selection -d 'How to choose the resonance band' -r -f -a "kurtogram\t''

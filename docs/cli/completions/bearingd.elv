@@ -69,10 +69,11 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --duration 'Stop after this many seconds of sample time (default: run until SIGINT/SIGTERM)'
             cand --data-dir 'Where to keep state (DIR/state) and logs (DIR/mcap); overrides outputs.state_dir and outputs.mcap_dir of --config. Without --config, default ./bearingd-data'
             cand --fleet 'Also publish to this MQTT broker (mqtt://HOST:PORT or mqtts://HOST:PORT) with the fleet bridge''s defaults, node id = this host''s name: a first look; a service sets [fleet] in its config (docs/FLEET.md)'
+            cand --format 'Output format'
             cand --fast 'Run simulated sensors as fast as the analysis allows instead of in real time'
             cand --quiet 'No status lines (flags and the summary are still printed)'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;import'= {
             cand --out 'Directory for the MCAP log and replay.toml'
@@ -83,6 +84,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --bearing 'Bearing: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or custom geometry "z=8,d=5.97mm,D=31.62mm,alpha=0"'
             cand --unit 'Unit of the file''s values, for WAV, plain CSV and .mat files (default: g; for an integer WAV, fractions of full scale). m/s2 is converted to g; full-scale gives no velocity in mm/s'
             cand --sensor 'Sensor id in the log'
+            cand --format 'Output format'
             cand -h 'Print help (see more with ''--help'')'
             cand --help 'Print help (see more with ''--help'')'
         }
@@ -90,14 +92,16 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --config 'Analyse with this configuration instead of the one the log was recorded with (needed for logs without it: older files, `bearingd import`)'
             cand --speed 'Replay speed: 1 = real time; default: as fast as possible'
             cand --out 'Directory of the replay''s own MCAP log'
+            cand --format 'Output format'
             cand --quiet 'No progress (neither the bar on a terminal nor the lines elsewhere)'
-            cand --json 'Print the summary as JSON (flags with their sample times)'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand --json 'The same as --format json'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;validate'= {
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand --format 'Output format'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;ingest'= {
             cand --can 'Read SocketCAN interface IFACE (classic and FD frames)'
@@ -117,19 +121,21 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --expect-malformed 'Expect exactly N malformed frames in total'
             cand --expect-restarts 'Expect exactly N restarts in total (one per restarted stream)'
             cand --expect-sensor-lost 'Expect exactly N sensor-lost reports in total (a sender that stops is lost once)'
+            cand --format 'Output format'
             cand --block-when-full 'iceoryx2: when the hand-off queue is full, wait (push back into iceoryx2) instead of dropping the oldest batch'
-            cand --json 'Print the report as JSON'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand --json 'The same as --format json'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;alerts'= {
             cand --config 'The daemon''s config file (for its alert service and iceoryx2 root); without it, those of `bearingd run` without a config'
             cand --data-dir 'The `--data-dir` of a `bearingd run` without a config (default ./bearingd-data)'
+            cand --format 'Output format'
             cand --count 'Exit after this many alerts (the active alerts printed at start count)'
             cand --timeout 'Stop after this many seconds; with --count, an exit status of 1 if fewer came'
-            cand --json 'One JSON object per line instead of text'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand --json 'The same as --format json'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;fleet-decode'= {
             cand --pretty 'Indent the JSON (one object over several lines)'
@@ -139,15 +145,16 @@ set edit:completion:arg-completer[bearingd] = {|@words|
         &'bearingd;config'= {
             cand -h 'Print help'
             cand --help 'Print help'
-            cand default 'Print the documented default configuration (the embedded default: a simulated sensor)'
+            cand default 'Print the documented default configuration (the embedded default: a simulated sensor); with --format json, the same settings as one JSON document (without the comments)'
             cand help 'Print this message or the help of the given subcommand(s)'
         }
         &'bearingd;config;default'= {
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand --format 'Output format'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;config;help'= {
-            cand default 'Print the documented default configuration (the embedded default: a simulated sensor)'
+            cand default 'Print the documented default configuration (the embedded default: a simulated sensor); with --format json, the same settings as one JSON document (without the comments)'
             cand help 'Print this message or the help of the given subcommand(s)'
         }
         &'bearingd;config;help;default'= {
@@ -182,6 +189,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --machine-fault-velocity 'RMS velocity of the machine fault''s 1× line, mm/s'
             cand --onset 'Signal model: the fault appears at this time, s'
             cand --seed 'Random seed: the same seed gives the same record'
+            cand --format 'Output format'
             cand --nuisance 'Signal model: add what a real machine adds besides the bearing (shaft harmonics, shaft-modulated noise, random impulses, a gear mesh and a 100 Hz tone; see docs/DIAGNOSIS.md)'
             cand -h 'Print help (see more with ''--help'')'
             cand --help 'Print help (see more with ''--help'')'
@@ -190,9 +198,10 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --spec 'The spec (TOML): faults, records per fault, model and ranges; an example with every key: config/dataset.toml'
             cand --out 'Output directory (created): dataset.npz, manifest.csv, spec.toml, and mcap/NNNNN/'
             cand --bearing 'Simulate this bearing instead of the spec''s `bearing`: a catalog name (skf-6205-2rs, skf-6203-2rs, skf-61804, pronostia, mfpt, rexnord-za-2115) or a custom geometry. One spec makes the training set of every bearing''s model; the spec.toml written beside the set says the bearing used'
+            cand --format 'Output format'
             cand --mcap 'Also write each record as a raw MCAP log (mcap/NNNNN/), replayable without a config'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;train'= {
             cand --dataset 'A directory written by `bearingd dataset` (dataset.npz and spec.toml); repeat it to train on several (same classes, and same bearing on shaft orders), e.g. a signal-model and a physics set'
@@ -200,8 +209,9 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --epochs 'Passes over the training segments'
             cand --seed 'The seed of the initial weights, the corruption noise and the batch order'
             cand --axis 'The input''s axis: `shaft` orders (the model knows the data set''s one bearing) or `fault-relative` orders (each fault''s own; the model serves any bearing, best trained on data sets of many, e.g. `bearing = "random"`)'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand --format 'Output format'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;calibrate'= {
             cand --channel 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)'
@@ -220,6 +230,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --seed 'Seed of the search: the same seed gives the same calibration'
             cand --plot 'Draw the measured, calibrated and default spectra to this file (.png or .svg)'
             cand --save 'Write the calibrated parameters as JSON (for `simulate --model physics --calibrated`)'
+            cand --format 'Output format'
             cand -h 'Print help (see more with ''--help'')'
             cand --help 'Print help (see more with ''--help'')'
         }
@@ -230,12 +241,13 @@ set edit:completion:arg-completer[bearingd] = {|@words|
             cand --seed 'Seed of the sweep: the same seed gives the same records and results'
             cand --jobs 'Worker threads (default: the machine''s cores)'
             cand --config 'Take the analysis and threshold settings from this config file instead of the embedded default (to evaluate a tuned configuration). With `twin.learned_model` the sweep''s record path also writes agreement_grid.txt (the learned model''s agreement decided at every point of a parameter grid); with --recordings only its agreement_* keys and model are used, by both paths'
+            cand --format 'Output format'
             cand --all-channels 'With --recordings: also the other channels of each record (CWRU fan end and base, every axis of other files; IMS snapshots are always evaluated on all eight)'
             cand --strict 'With --recordings: exit 1 if any answer is confident and wrong, the paths disagree on any record, or any record fails (CI)'
             cand --quick 'The small sweep CI runs (both bearings at nominal speed, default severity, the simulator''s default noise and 0 dB SNR, healthy records) instead of the full one'
             cand --no-nuisance 'Leave out the machine''s nuisance (shaft harmonics, modulated noise, random impulses, gear and electrical tones): bearing, 1× tone and white noise only'
-            cand -h 'Print help'
-            cand --help 'Print help'
+            cand -h 'Print help (see more with ''--help'')'
+            cand --help 'Print help (see more with ''--help'')'
         }
         &'bearingd;trend'= {
             cand --channel 'Channel: DE, FE, BA, a variable or a field path such as bearing.gs (.mat); horizontal/vertical (PRONOSTIA); B1x…B4y (IMS); sensor/axis (MCAP log)'
@@ -293,7 +305,7 @@ set edit:completion:arg-completer[bearingd] = {|@words|
         &'bearingd;help;fleet-decode'= {
         }
         &'bearingd;help;config'= {
-            cand default 'Print the documented default configuration (the embedded default: a simulated sensor)'
+            cand default 'Print the documented default configuration (the embedded default: a simulated sensor); with --format json, the same settings as one JSON document (without the comments)'
         }
         &'bearingd;help;config;default'= {
         }

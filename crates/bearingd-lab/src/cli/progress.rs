@@ -50,7 +50,7 @@ impl Progress {
             bar,
             command,
             unit,
-            total: total.max(1),
+            total,
             done: AtomicU64::new(0),
             started: now,
             last_line: Mutex::new(now),
@@ -83,7 +83,8 @@ impl Progress {
             bar.set_message(detail.to_string());
             return;
         }
-        let quarter = done * 4 / self.total != before * 4 / self.total;
+        let total = self.total.max(1);
+        let quarter = done * 4 / total != before * 4 / total;
         let due = self.lock_last().elapsed() >= LINE_EVERY;
         if (quarter && done < self.total) || due {
             self.line(done, detail);
