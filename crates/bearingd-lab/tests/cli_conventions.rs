@@ -213,3 +213,31 @@ sys.exit(os.waitstatus_to_exitcode(status))
         "plain lines on a terminal: {seen:?}"
     );
 }
+
+#[test]
+fn evaluate_prints_its_summary_and_the_files_written_as_json() {
+    let dir = scratch_dir("cli-json-evaluate");
+    let out = dir.join("fa");
+    let said = json_of(&[
+        "evaluate",
+        "--false-alarm-hours",
+        "0.01",
+        "--jobs",
+        "2",
+        "--out",
+        s(&out),
+    ]);
+    assert_eq!(said["evaluation"], "false alarms", "{said}");
+    assert!(
+        said["summary"]["all"]["decisions"].as_u64().unwrap() > 0,
+        "{said}"
+    );
+    let written: Vec<&str> = said["written"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| w.as_str().unwrap())
+        .collect();
+    assert_eq!(written.len(), 2, "{said}");
+    assert!(written.iter().all(|w| Path::new(w).is_file()), "{said}");
+}
