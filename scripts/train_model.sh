@@ -7,8 +7,8 @@
 #   scripts/train_model.sh models/skf-6203-2rs.safetensors skf-6203-2rs
 # About two minutes on two cores. CI runs it for the 6205 into target/ and
 # scripts/check_model.py checks the result is the committed model: byte for byte on a machine
-# like the one that made it, the same card, accuracy and verdicts on another CPU (whose SIMD
-# kernels round sums in another order). The test `learned::every_shipped_model_…` checks each
+# like the one that made it, the same card, accuracy, verdicts and weights within a measured
+# tolerance on another CPU (whose SIMD kernels round sums in another order). The test `learned::every_shipped_model_…` checks each
 # model of models/ is made by these specs for its bearing and names fresh records of it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
