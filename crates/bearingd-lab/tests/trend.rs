@@ -479,6 +479,26 @@ fn the_manifest_s_speed_gives_the_fault_score_without_rpm() {
     let note = note_with(&report, "the data set's manifest").unwrap_or_default();
     assert!(note.contains("1800 rpm"), "{report}");
     assert!(note_with(&report, "give --rpm").is_none(), "{report}");
+
+    // A manifest that cannot be read is said, with the reason and the way out, not skipped
+    // in silence.
+    std::fs::write(
+        dir.parent().unwrap().join("manifest.csv"),
+        "name,rpm\nBearing1_2/acc_00001.csv,1800\n",
+    )
+    .unwrap();
+    let report = trend_json(&dir, &["--baseline", "3", "--no-hw"]);
+    let note = note_with(&report, "not a readable data set manifest").unwrap_or_default();
+    assert!(
+        note.contains("manifest.csv")
+            && note.contains("no `file` column")
+            && note.contains("give --rpm"),
+        "{report}"
+    );
+    assert!(
+        note_with(&report, "the data set's manifest:").is_none(),
+        "{report}"
+    );
 }
 
 /// A log whose daemon fits the HW model but holds no fit yet (4 s, before the first re-fit

@@ -111,6 +111,7 @@ pub fn run(args: &TrendArgs) -> Result<(), CliError> {
     let mut clock = LogClock::default();
     let mut hw_note = HwNote::default();
     let manifest = ManifestSpeeds::find(&args.path);
+    notes.extend(manifest.unreadable.iter().cloned());
     let progress = Progress::start("trend", "files", placed.len() as u64);
     for (done, file) in placed.iter().enumerate() {
         progress.set(done as u64, &format!("{} snapshots", points.len()));
@@ -324,6 +325,9 @@ fn residual_in(fits: &[LoggedHwFit], (from, to): (u64, u64)) -> Option<f64> {
 struct ManifestSpeeds {
     path: PathBuf,
     rpm: HashMap<PathBuf, f64>,
+    /// A `manifest.csv` found but not readable as a data set's manifest, and why: said in a
+    /// note, never skipped in silence (the speeds it would have given are missing).
+    unreadable: Vec<String>,
 }
 
 impl ManifestSpeeds {
@@ -338,9 +342,16 @@ impl ManifestSpeeds {
             .flat_map(|d| [Some(d), d.parent()])
             .flatten()
             .map(|d| d.join("manifest.csv"));
-        for candidate in candidates {
-            let Ok(manifest) = Manifest::read(&candidate) else {
-                continue;
+        let mut unreadable = Vec::new();
+        for candidate in candidates.filter(|c| c.is_file()) {
+            let manifest = match Manifest::read(&candidate) {
+                Ok(manifest) => manifest,
+                Err(e) => {
+                    unreadable.push(format!(
+                        "no speed taken from a manifest that is not a readable data set manifest: {e}; mend it, or give --rpm"
+                    ));
+                    continue;
+                }
             };
             let rpm: HashMap<PathBuf, f64> = manifest
                 .records
@@ -351,10 +362,14 @@ impl ManifestSpeeds {
                 return ManifestSpeeds {
                     path: candidate,
                     rpm,
+                    unreadable,
                 };
             }
         }
-        ManifestSpeeds::default()
+        ManifestSpeeds {
+            unreadable,
+            ..ManifestSpeeds::default()
+        }
     }
 
     /// The manifest's speed of `file`, said in a note.
