@@ -85,6 +85,12 @@ impl Remarks {
         self.notes.push(text);
     }
 
+    /// The notes and warnings of resolved conditions (speed, bearing, unit), in that order.
+    pub fn extend(&mut self, notes: &[String], warnings: &[String]) {
+        notes.iter().for_each(|n| self.note(n.as_str()));
+        warnings.iter().for_each(|w| self.warning(w.as_str()));
+    }
+
     pub fn warning(&mut self, text: impl Into<String>) {
         let text = text.into();
         if !self.json {

@@ -39,14 +39,7 @@ pub fn run(args: &ImportArgs) -> Result<(), CliError> {
     };
     let conditions = resolve_conditions(&recording, &request, false).map_err(CliError::input)?;
     let mut remarks = Remarks::new("bearingd: import", args.format.json());
-    conditions
-        .notes
-        .iter()
-        .for_each(|n| remarks.note(n.as_str()));
-    conditions
-        .warnings
-        .iter()
-        .for_each(|w| remarks.warning(w.as_str()));
+    remarks.extend(&conditions.notes, &conditions.warnings);
     if recording.unit == SampleUnit::FullScale {
         remarks.warning("the log states its samples in g, so these fractions of full scale will be read as g (thresholds, velocity); give --unit g or --unit m/s2 if the recorder's full scale is known");
     }

@@ -105,14 +105,7 @@ pub fn run(args: &CalibrateArgs) -> Result<(), CliError> {
     };
     let conditions = resolve_conditions(&recording, &request, false).map_err(CliError::input)?;
     let mut remarks = Remarks::new("bearingd", args.format.json());
-    conditions
-        .notes
-        .iter()
-        .for_each(|n| remarks.note(n.as_str()));
-    conditions
-        .warnings
-        .iter()
-        .for_each(|w| remarks.warning(w.as_str()));
+    remarks.extend(&conditions.notes, &conditions.warnings);
     let file = args.file.display().to_string();
     let samples: Vec<f32> = recording.samples.iter().map(|&x| x as f32).collect();
     let freqs = conditions.bearing.fault_frequencies(conditions.rpm / 60.0);
