@@ -43,11 +43,8 @@ python=${PYTHON:-$ROOT/.venv/bin/python}
 # 2. Kernel and busybox.
 vm_kernel
 
-# 3. Static binaries, without iceoryx2 (not needed in the VM; shorter build).
-say "cargo build (musl, feature can)"
-(cd "$ROOT" && cargo build --release --quiet --target x86_64-unknown-linux-musl \
-  -p bearingd -p firmware-sim --no-default-features --features bearingd/can,firmware-sim/can)
-BIN=$ROOT/target/x86_64-unknown-linux-musl/release
+# 3. Static binaries, the build every VM test shares (common.sh).
+vm_binaries
 
 # 4. initramfs.
 say "initramfs"
@@ -60,7 +57,9 @@ done
 for m in net/can/can.ko net/can/can-raw.ko drivers/net/can/dev/can-dev.ko drivers/net/can/vcan.ko; do
   cp "$MODDIR/$m" "$IR/lib/modules/"
 done
-cp "$BIN/bearingd" "$BIN/firmware-sim" "$IR/bin/"
+# Stripped: the release profile's debug info would only fatten the initramfs.
+strip -o "$IR/bin/bearingd" "$MUSL_BIN/bearingd"
+strip -o "$IR/bin/firmware-sim" "$MUSL_BIN/firmware-sim"
 mkdir -p "$IR/etc"
 cp "$ROOT/tests/vm/run.toml" "$IR/etc/bearingd-run.toml"
 cp "$ROOT/tests/vm/init.sh" "$IR/init"

@@ -48,3 +48,15 @@ vm_kernel() {
   MODDIR=$WORK/kroot/lib/modules/$KVER/kernel
   BB=$WORK/bbroot/bin/busybox
 }
+
+# vm_binaries: the static (musl) bearingd and firmware-sim every VM test runs, built by one
+# cargo command with the default features (SocketCAN, iceoryx2, TLS) so that the three VM
+# tests share one build: the first builds (about 5 min on 2 cores), the next two find it
+# done. A different package set or feature list would unify features differently and rebuild
+# every crate whose features changed. Sets MUSL_BIN, the directory of both binaries.
+vm_binaries() {
+  say "cargo build --release --locked (musl: bearingd, firmware-sim; shared by the VM tests)"
+  (cd "$ROOT" && cargo build --release --locked --quiet --target x86_64-unknown-linux-musl \
+    -p bearingd -p firmware-sim) || missing "the static binaries" "see the cargo errors above"
+  MUSL_BIN=$ROOT/target/x86_64-unknown-linux-musl/release
+}

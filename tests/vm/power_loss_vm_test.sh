@@ -37,11 +37,11 @@ python=${PYTHON:-$ROOT/.venv/bin/python}
 # 2. Kernel and busybox.
 vm_kernel
 
-# 3. bearingd, static (musl), as the systemd VM test builds it; the host's for the replay.
-say "cargo build --release --locked (musl; host)"
-(cd "$ROOT" && cargo build --release --locked --quiet --target x86_64-unknown-linux-musl -p bearingd)
-(cd "$ROOT" && cargo build --release --locked --quiet -p bearingd)
-HOSTBIN=$ROOT/target/release/bearingd
+# 3. bearingd, static (musl), the build every VM test shares (common.sh). The same binary
+#    replays the logs on the host: a static binary runs there too, and a host build of
+#    `-p bearingd` alone would unify features differently from the test step's and rebuild.
+vm_binaries
+HOSTBIN=$MUSL_BIN/bearingd
 
 # 4. initramfs: busybox, the block and ext4 modules, bearingd, one config per case.
 say "initramfs"
@@ -57,7 +57,7 @@ for m in virtio_ring virtio virtio_pci_modern_dev virtio_pci_legacy_dev virtio_p
   # Built into this kernel when absent (the init skips it).
   [ -n "$found" ] && cp "$found" "$IR/lib/modules/"
 done
-strip -o "$IR/bin/bearingd" "$ROOT/target/x86_64-unknown-linux-musl/release/bearingd"
+strip -o "$IR/bin/bearingd" "$MUSL_BIN/bearingd"
 for case in synced control; do
   case $case in synced) every=2;; control) every=3600;; esac
   "$HOSTBIN" config default |

@@ -70,9 +70,8 @@ fi
 
 # 4. bearingd as a static musl binary, with iceoryx2 (alerts) and SocketCAN. Stripped for the
 #    VM: the release profile keeps debug info, which would only fatten the initramfs.
-say "cargo build --release --locked (musl)"
-(cd "$ROOT" && cargo build --release --locked --quiet --target x86_64-unknown-linux-musl -p bearingd)
-strip -o "$WORK/bearingd" "$ROOT/target/x86_64-unknown-linux-musl/release/bearingd"
+vm_binaries
+strip -o "$WORK/bearingd" "$MUSL_BIN/bearingd"
 
 # 5. The VM's root: a fresh copy of the base, then installed as an administrator would.
 say "make install-service DESTDIR=<root> BIN=<musl binary>"
