@@ -35,6 +35,10 @@ export CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_LINKER=aarch64-linux-gnu-gcc
 export CARGO_TARGET_AARCH64_UNKNOWN_LINUX_GNU_RUNNER="qemu-aarch64 -L $sysroot"
 export CC_aarch64_unknown_linux_gnu=aarch64-linux-gnu-gcc
 export AR_aarch64_unknown_linux_gnu=aarch64-linux-gnu-ar
+# No debug info for this target: it changes no instruction of the code under test, and the
+# release profile's line tables make every crate slower to build and every test binary slower
+# to link (CI's time budget; the x86 builds keep them for perf and callgrind).
+export CARGO_PROFILE_RELEASE_DEBUG=0
 
 # Unit tests (the crates' own #[test]s; the integration suite needs a real kernel, iceoryx2
 # processes and Python, which stay on the x86 runs and in the VMs). Each test skipped here runs
