@@ -51,16 +51,63 @@ pub fn repo_root() -> PathBuf {
 
 /// A fresh, empty scratch directory under the system temp dir, unique per process and call.
 ///
+/// A test's directory outlives it, so that a failure can be looked into; the first call of
+/// each test process removes those of test processes that have ended ([`remove_stale_scratch`]),
+/// so runs do not pile up in the temp dir (a full `cargo test --workspace` leaves about 0.5 GB,
+/// copies of the binaries included).
+///
 /// # Panics
 /// When the directory cannot be created (tests only).
 pub fn scratch_dir(test: &str) -> PathBuf {
     static COUNTER: AtomicUsize = AtomicUsize::new(0);
+    static STALE_REMOVED: std::sync::Once = std::sync::Once::new();
+    STALE_REMOVED.call_once(|| {
+        remove_stale_scratch(&std::env::temp_dir(), process_alive);
+    });
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!("bearingd-{test}-{}-{n}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir)
         .unwrap_or_else(|e| panic!("cannot create scratch dir {}: {e}", dir.display()));
     dir
+}
+
+/// Removes the scratch directories in `temp` ([`scratch_dir`]'s `bearingd-<test>-<pid>-<n>`)
+/// whose process `alive` says has ended; what cannot be removed (another user's) is left.
+/// Returns how many were removed.
+pub fn remove_stale_scratch(temp: &Path, alive: impl Fn(u32) -> bool) -> usize {
+    let Ok(entries) = std::fs::read_dir(temp) else {
+        return 0;
+    };
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(scratch_pid) else {
+            continue;
+        };
+        let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
+        if is_dir && !alive(pid) && std::fs::remove_dir_all(entry.path()).is_ok() {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// The process id in a scratch directory's name `bearingd-<test>-<pid>-<n>`.
+fn scratch_pid(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix("bearingd-")?;
+    let mut fields = rest.rsplitn(3, '-');
+    let n = fields.next()?;
+    let pid = fields.next()?;
+    let test = fields.next()?;
+    let digits = |s: &str| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit());
+    (digits(n) && !test.is_empty()).then_some(())?;
+    pid.parse().ok().filter(|_| digits(pid))
+}
+
+/// Whether process `pid` is running (Linux: its /proc entry exists).
+fn process_alive(pid: u32) -> bool {
+    Path::new("/proc").join(pid.to_string()).exists()
 }
 
 /// An iceoryx2 root for a test, unique per process and `tag`: below `target_tmp` (pass
@@ -332,4 +379,58 @@ pub fn run_binary(program: &str, args: &[&str]) -> std::process::Output {
         args.join(" ")
     );
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scratch_name_gives_its_process_and_nothing_else_does() {
+        assert_eq!(scratch_pid("bearingd-alerts-cli-11924-0"), Some(11924));
+        assert_eq!(scratch_pid("bearingd-trend-7-12"), Some(7));
+        for other in [
+            "bearingd-tests-0",
+            "bearingd--5-1",
+            "bearingd-x-5-",
+            "bearingd-x-y-1",
+            "bearingd-x-5-1a",
+            "ci-check",
+            "bearingd",
+        ] {
+            assert_eq!(scratch_pid(other), None, "{other}");
+        }
+    }
+
+    #[test]
+    fn only_the_directories_of_ended_processes_are_removed() {
+        let temp = scratch_dir("stale-scratch");
+        for name in [
+            "bearingd-done-100-0",
+            "bearingd-done-too-100-3",
+            "bearingd-running-200-0",
+            "other-100-0",
+        ] {
+            std::fs::create_dir_all(temp.join(name).join("inner")).expect("make a dir");
+        }
+        std::fs::write(temp.join("bearingd-file-100-1"), b"not a dir").expect("write a file");
+        let removed = remove_stale_scratch(&temp, |pid| pid == 200);
+        assert_eq!(removed, 2);
+        let mut left: Vec<String> = std::fs::read_dir(&temp)
+            .expect("read the temp dir")
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(
+            left,
+            [
+                "bearingd-file-100-1",
+                "bearingd-running-200-0",
+                "other-100-0"
+            ]
+        );
+        assert_eq!(remove_stale_scratch(&temp.join("missing"), |_| false), 0);
+        let _ = std::fs::remove_dir_all(&temp);
+    }
 }
