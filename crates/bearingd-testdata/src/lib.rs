@@ -73,10 +73,17 @@ pub fn scratch_dir(test: &str) -> PathBuf {
 }
 
 /// Removes the scratch directories in `temp` ([`scratch_dir`]'s `bearingd-<test>-<pid>-<n>`)
-/// whose process `alive` says has ended; what cannot be removed (another user's) is left.
-/// Returns how many were removed.
+/// that this user owns and whose process `alive` says has ended. The temp dir is shared: a
+/// link is never followed (the entry's own type; `remove_dir_all` unlinks a link that replaced
+/// it), and another user's directory of that name is left alone, also when the tests run as
+/// root. Returns how many were removed.
 pub fn remove_stale_scratch(temp: &Path, alive: impl Fn(u32) -> bool) -> usize {
+    use std::os::unix::fs::MetadataExt;
     let Ok(entries) = std::fs::read_dir(temp) else {
+        return 0;
+    };
+    // This process's user: the owner of its /proc entry (Linux, as `process_alive`).
+    let Ok(me) = std::fs::metadata("/proc/self").map(|m| m.uid()) else {
         return 0;
     };
     let mut removed = 0;
@@ -85,8 +92,11 @@ pub fn remove_stale_scratch(temp: &Path, alive: impl Fn(u32) -> bool) -> usize {
         let Some(pid) = name.to_str().and_then(scratch_pid) else {
             continue;
         };
-        let is_dir = entry.file_type().is_ok_and(|t| t.is_dir());
-        if is_dir && !alive(pid) && std::fs::remove_dir_all(entry.path()).is_ok() {
+        // `DirEntry::metadata` does not follow a link.
+        let mine = entry
+            .metadata()
+            .is_ok_and(|m| m.file_type().is_dir() && m.uid() == me);
+        if mine && !alive(pid) && std::fs::remove_dir_all(entry.path()).is_ok() {
             removed += 1;
         }
     }
@@ -414,8 +424,13 @@ mod tests {
             std::fs::create_dir_all(temp.join(name).join("inner")).expect("make a dir");
         }
         std::fs::write(temp.join("bearingd-file-100-1"), b"not a dir").expect("write a file");
+        // A link named like an ended process's directory is not a directory: it and its
+        // target stay.
+        let target = temp.join("other-100-0");
+        std::os::unix::fs::symlink(&target, temp.join("bearingd-link-100-2")).expect("make a link");
         let removed = remove_stale_scratch(&temp, |pid| pid == 200);
         assert_eq!(removed, 2);
+        assert!(target.join("inner").is_dir(), "a link's target was removed");
         let mut left: Vec<String> = std::fs::read_dir(&temp)
             .expect("read the temp dir")
             .flatten()
@@ -426,6 +441,7 @@ mod tests {
             left,
             [
                 "bearingd-file-100-1",
+                "bearingd-link-100-2",
                 "bearingd-running-200-0",
                 "other-100-0"
             ]
