@@ -67,7 +67,9 @@ pub fn scratch_dir(test: &str) -> PathBuf {
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     let dir = std::env::temp_dir().join(format!("bearingd-{test}-{}-{n}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir)
+    // `create_dir`, not `_all`: the temp dir is shared, and a directory (or a link to one) that
+    // someone else put at this name after the removal must fail the test, not be written into.
+    std::fs::create_dir(&dir)
         .unwrap_or_else(|e| panic!("cannot create scratch dir {}: {e}", dir.display()));
     dir
 }
