@@ -6,7 +6,7 @@ use super::fit::{
     fit_range_hz, HypothesisFit, MeasuredEnvelope, MeasuredPowerSpectrum, TwinFitter, TwinParams,
     HYPOTHESES,
 };
-use super::model::stribeck_load;
+use super::model::{stribeck_load, LOAD_EXPONENT, LOAD_ZONE};
 use crate::analysis::diagnosis::{Diagnosis, Verdict};
 use crate::analysis::envelope::{
     hop_samples, welch_envelope_spectrum, welch_power_spectrum, window_starts, BandEnvelope,
@@ -180,7 +180,14 @@ fn time_residual(
     // q² on a table of angles: the inner loop then needs no trigonometry.
     const ANGLES: usize = 360;
     let load_table: Vec<f64> = (0..ANGLES)
-        .map(|i| stribeck_load(std::f64::consts::TAU * i as f64 / ANGLES as f64, 0.5, 1.5).powi(2))
+        .map(|i| {
+            stribeck_load(
+                std::f64::consts::TAU * i as f64 / ANGLES as f64,
+                LOAD_ZONE,
+                LOAD_EXPONENT,
+            )
+            .powi(2)
+        })
         .collect();
     let p = &fit.params;
     let mut ratios = Vec::new();

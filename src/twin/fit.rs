@@ -150,8 +150,7 @@ impl TwinFitter {
         let nominal = fault.frequency(freqs);
         let top = fit_range_hz(nominal, self.bounds.slip).min(measured.band.width_hz());
         let bins = ((top / measured.bin_hz).floor() as usize + 1).min(measured.amplitude.len());
-        let model =
-            EnvelopeModel::new(fault, freqs, measured.band, measured.bin_hz, bins, 0.5, 1.5);
+        let model = EnvelopeModel::new(fault, freqs, measured.band, measured.bin_hz, bins);
         self.twin.resize(bins, 0.0);
         self.noise.resize(bins, 0.0);
         self.measured.clear();
@@ -305,7 +304,7 @@ impl TwinFitter {
         params: &TwinParams,
         out: &mut [f64],
     ) {
-        let model = EnvelopeModel::new(fault, freqs, band, bin_hz, out.len(), 0.5, 1.5);
+        let model = EnvelopeModel::new(fault, freqs, band, bin_hz, out.len());
         self.noise.resize(out.len(), 0.0);
         model.basis(&params.shape(), out, &mut self.noise);
         let twin_scale = params.a.powi(4);

@@ -30,6 +30,7 @@ use crate::bearing::FaultFrequencies;
 use crate::messages::FaultKind;
 use rustfft::num_complex::Complex64;
 use std::f64::consts::{PI, TAU};
+use std::sync::OnceLock;
 
 /// The shape parameters of the twin (everything but the amplitude and the noise level).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -49,6 +50,11 @@ const MODULATION_ORDERS: i32 = 8;
 /// Bins on each side of a line that its Hann kernel reaches.
 const KERNEL_HALF_WIDTH: i32 = 3;
 
+/// Load zone ε of the Stribeck distribution the twin assumes (MODELS.md §4; not fitted).
+pub const LOAD_ZONE: f64 = 0.5;
+/// Load exponent n of that distribution (3/2 for ball bearings).
+pub const LOAD_EXPONENT: f64 = 1.5;
+
 /// Everything about one fault hypothesis that does not change during a fit.
 #[derive(Debug, Clone)]
 pub struct EnvelopeModel {
@@ -58,12 +64,76 @@ pub struct EnvelopeModel {
     pub bins: usize,
     /// Frequency of the load modulation (0 for an outer race).
     modulation_hz: f64,
+    load: &'static LoadSpectrum,
+    /// Per bin, where it falls on the coarse grid of `|P(f)|²`: the grid interval and the
+    /// fraction into it (the grid spans the model's bins, so this is fixed per model).
+    grid_position: Vec<(usize, f64)>,
+    /// The noise shape `N` per bin (fixed per model).
+    noise_shape: Vec<f64>,
+}
+
+/// The squared load `q²` over the modulation, in Fourier coefficients: the same for every
+/// model with (or every model without) a modulation, so computed once per process.
+#[derive(Debug)]
+struct LoadSpectrum {
     /// `Q_l` for `l = −L..=L` (index `l + L`).
-    load_coefficients: Vec<Complex64>,
+    coefficients: Vec<Complex64>,
     /// Mean of `q⁴` over the modulation.
-    load_fourth_moment: f64,
+    fourth_moment: f64,
     /// Modulation orders that carry power (`|Q_l|² > 10⁻⁵·|Q_0|²`), at most [`MODULATION_ORDERS`].
     orders: i32,
+}
+
+impl LoadSpectrum {
+    /// The load spectrum of a defect that moves through the load zone (`modulated`: inner
+    /// race, ball) or stays on the load line (outer race).
+    fn of(modulated: bool) -> &'static LoadSpectrum {
+        static MODULATED: OnceLock<LoadSpectrum> = OnceLock::new();
+        static FIXED: OnceLock<LoadSpectrum> = OnceLock::new();
+        let cell = if modulated { &MODULATED } else { &FIXED };
+        cell.get_or_init(|| LoadSpectrum::compute(modulated))
+    }
+
+    fn compute(modulated: bool) -> LoadSpectrum {
+        const STEPS: usize = 360;
+        let squared_load: Vec<f64> = (0..STEPS)
+            .map(|i| {
+                let theta = if modulated {
+                    TAU * i as f64 / STEPS as f64
+                } else {
+                    0.0
+                };
+                stribeck_load(theta, LOAD_ZONE, LOAD_EXPONENT).powi(2)
+            })
+            .collect();
+        let coefficients: Vec<Complex64> = (-MODULATION_ORDERS..=MODULATION_ORDERS)
+            .map(|l| {
+                squared_load
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &q2)| {
+                        Complex64::from_polar(q2, -f64::from(l) * TAU * i as f64 / STEPS as f64)
+                    })
+                    .sum::<Complex64>()
+                    / STEPS as f64
+            })
+            .collect();
+        let fourth_moment = squared_load.iter().map(|q2| q2 * q2).sum::<f64>() / STEPS as f64;
+        let coefficient_power = |l: i32| load_coefficients_power(&coefficients, l);
+        let orders = if modulated {
+            (1..=MODULATION_ORDERS)
+                .rev()
+                .find(|&l| coefficient_power(l) > 1e-5 * coefficient_power(0))
+                .unwrap_or(0)
+        } else {
+            0
+        };
+        LoadSpectrum {
+            coefficients,
+            fourth_moment,
+            orders,
+        }
+    }
 }
 
 /// Stribeck load `q(θ)/q_max` (MODELS.md §4).
@@ -77,64 +147,41 @@ pub fn stribeck_load(theta: f64, load_zone: f64, exponent: f64) -> f64 {
 }
 
 impl EnvelopeModel {
-    /// `load_zone` ε and `load_exponent` n of the Stribeck distribution; the defect starts on
-    /// the load line.
+    /// The load follows the Stribeck distribution of [`LOAD_ZONE`] and [`LOAD_EXPONENT`]; the
+    /// defect starts on the load line.
     pub fn new(
         fault: FaultKind,
         freqs: &FaultFrequencies,
         band: Band,
         bin_hz: f64,
         bins: usize,
-        load_zone: f64,
-        load_exponent: f64,
     ) -> Self {
         let modulation_hz = match fault {
             FaultKind::InnerRace => freqs.shaft,
             FaultKind::Ball => freqs.ftf,
             FaultKind::OuterRace | FaultKind::Cage => 0.0,
         };
-        const STEPS: usize = 360;
-        let squared_load: Vec<f64> = (0..STEPS)
-            .map(|i| {
-                let theta = if modulation_hz > 0.0 {
-                    TAU * i as f64 / STEPS as f64
-                } else {
-                    0.0
-                };
-                stribeck_load(theta, load_zone, load_exponent).powi(2)
+        let grid_per_bin = bin_hz / (bins as f64 * bin_hz / GRID_POINTS as f64);
+        let grid_position = (0..bins)
+            .map(|k| {
+                let x = k as f64 * grid_per_bin;
+                let i = (x as usize).min(GRID_POINTS - 1);
+                (i, x - i as f64)
             })
             .collect();
-        let load_coefficients: Vec<Complex64> = (-MODULATION_ORDERS..=MODULATION_ORDERS)
-            .map(|l| {
-                squared_load
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &q2)| {
-                        Complex64::from_polar(q2, -f64::from(l) * TAU * i as f64 / STEPS as f64)
-                    })
-                    .sum::<Complex64>()
-                    / STEPS as f64
-            })
+        let noise_per_bin = bin_hz / band.width_hz();
+        let noise_shape = (0..bins)
+            .map(|k| (1.0 - k as f64 * noise_per_bin).max(0.0))
             .collect();
-        let load_fourth_moment = squared_load.iter().map(|q2| q2 * q2).sum::<f64>() / STEPS as f64;
-        let coefficient_power = |l: i32| load_coefficients_power(&load_coefficients, l);
-        let orders = if modulation_hz > 0.0 {
-            (1..=MODULATION_ORDERS)
-                .rev()
-                .find(|&l| coefficient_power(l) > 1e-5 * coefficient_power(0))
-                .unwrap_or(0)
-        } else {
-            0
-        };
         EnvelopeModel {
             fault,
             band,
             bin_hz,
             bins,
             modulation_hz,
-            load_coefficients,
-            load_fourth_moment,
-            orders,
+            load: LoadSpectrum::of(modulation_hz > 0.0),
+            grid_position,
+            noise_shape,
         }
     }
 
@@ -153,6 +200,30 @@ impl EnvelopeModel {
             / (Complex64::new(0.0, TAU) * Complex64::new(2.0 * decay, TAU * f))
     }
 
+    /// `|T(f)|²` of [`Self::impact_envelope_transform`], which is all the basis needs, with one
+    /// logarithm and two arctangents instead of four complex logarithms.
+    ///
+    /// With `A(u) = decay + i2π(f + u)` and `B(u) = decay − i2πu` the numerator is
+    /// `ln A_h − ln B_h − ln A_l + ln B_l`: its real part is `½ ln(|A_h|²|B_l|² / (|B_h|²|A_l|²))`,
+    /// its imaginary part `arg(A_h·conj A_l) − arg(B_h·conj B_l)`, exact without a 2π correction
+    /// because every `A` and `B` has a positive real part (arguments in (−π/2, π/2)).
+    pub fn impact_envelope_power(&self, f: f64, decay: f64, resonance: f64) -> f64 {
+        let u_low = self.band.lo_hz - resonance;
+        let u_high = self.band.hi_hz - f - resonance;
+        if u_high <= u_low {
+            return 0.0;
+        }
+        let a = |u: f64| Complex64::new(decay, TAU * (f + u));
+        let b = |u: f64| Complex64::new(decay, -TAU * u);
+        let (a_high, a_low, b_high, b_low) = (a(u_high), a(u_low), b(u_high), b(u_low));
+        let real = 0.5
+            * ((a_high.norm_sqr() * b_low.norm_sqr()) / (b_high.norm_sqr() * a_low.norm_sqr()))
+                .ln();
+        let imaginary = (a_high * a_low.conj()).arg() - (b_high * b_low.conj()).arg();
+        let denominator = TAU * TAU * (4.0 * decay * decay + (TAU * f).powi(2));
+        (real * real + imaginary * imaginary) / denominator
+    }
+
     /// Writes the unit-amplitude twin spectrum `U` and the noise shape `N` into the two
     /// slices (`bins` values each, power per bin as in the Welch spectrum).
     ///
@@ -160,6 +231,7 @@ impl EnvelopeModel {
     /// evaluated on a coarse grid and interpolated; this keeps an evaluation at a few
     /// microseconds.
     pub fn basis(&self, params: &ShapeParams, twin: &mut [f64], noise: &mut [f64]) {
+        debug_assert!(twin.len() == self.bins && noise.len() == self.bins);
         twin.iter_mut().for_each(|v| *v = 0.0);
         let f_d = params.impact_rate_hz;
         let sigma_t = params.jitter / f_d.max(1e-9);
@@ -168,13 +240,11 @@ impl EnvelopeModel {
         let mut grid = [0f64; GRID_POINTS + 1];
         let grid_step = top_hz / GRID_POINTS as f64;
         for (i, g) in grid.iter_mut().enumerate() {
-            *g = self
-                .impact_envelope_transform(
-                    i as f64 * grid_step,
-                    params.decay_per_s,
-                    params.resonance_hz,
-                )
-                .norm_sqr();
+            *g = self.impact_envelope_power(
+                i as f64 * grid_step,
+                params.decay_per_s,
+                params.resonance_hz,
+            );
         }
         let transform_power = |f: f64| {
             let x = (f / grid_step).clamp(0.0, GRID_POINTS as f64);
@@ -185,36 +255,31 @@ impl EnvelopeModel {
 
         // Lines at m·f_d + l·f_mod.
         let max_m = (top_hz / f_d).ceil() as i32 + 1;
-        let orders = self.orders;
+        let orders = self.load.orders;
         for m in 0..=max_m {
             for l in -orders..=orders {
                 let f = f64::from(m) * f_d + f64::from(l) * self.modulation_hz;
                 if f <= 0.5 * self.bin_hz || f >= top_hz {
                     continue;
                 }
-                let q = self.load_coefficients[(l + MODULATION_ORDERS) as usize].norm_sqr();
+                let q = load_coefficients_power(&self.load.coefficients, l);
                 let power = 4.0 * q * f_d * f_d * transform_power(f) * jitter_power(f);
                 self.spread_line(f, power, twin);
             }
         }
         // The continuum the jitter makes.
-        let continuum_scale = 6.0 * self.bin_hz * f_d * self.load_fourth_moment;
-        let bandwidth = self.band.width_hz();
+        let continuum_scale = 6.0 * self.bin_hz * f_d * self.load.fourth_moment;
         // e^{−c·k²} by recurrence: e^{−c(k+1)²} = e^{−ck²}·e^{−c(2k+1)}.
         let c = (TAU * self.bin_hz * sigma_t).powi(2);
         let (mut gaussian, mut step, step_ratio) = (1.0, (-c).exp(), (-2.0 * c).exp());
-        let grid_per_bin = self.bin_hz / grid_step;
-        let noise_per_bin = self.bin_hz / bandwidth;
-        for (k, (t, n)) in twin.iter_mut().zip(noise.iter_mut()).enumerate() {
-            let x = k as f64 * grid_per_bin;
-            let i = (x as usize).min(GRID_POINTS - 1);
-            let frac = x - i as f64;
+        for (t, &(i, frac)) in twin.iter_mut().zip(&self.grid_position) {
             let transform = grid[i] + (grid[i + 1] - grid[i]) * frac;
             *t += continuum_scale * transform * (1.0 - gaussian);
             gaussian *= step;
             step *= step_ratio;
-            *n = (1.0 - k as f64 * noise_per_bin).max(0.0);
         }
+        let shape = &self.noise_shape[..noise.len().min(self.noise_shape.len())];
+        noise[..shape.len()].copy_from_slice(shape);
         twin[0] = 0.0;
     }
 
@@ -270,15 +335,7 @@ mod tests {
         let freqs = crate::bearing::BearingGeometry::from_catalog("skf-6205-2rs")
             .unwrap()
             .fault_frequencies(29.5);
-        let model = EnvelopeModel::new(
-            FaultKind::OuterRace,
-            &freqs,
-            Band::new(-1e7, 1e7),
-            1.0,
-            10,
-            0.5,
-            1.5,
-        );
+        let model = EnvelopeModel::new(FaultKind::OuterRace, &freqs, Band::new(-1e7, 1e7), 1.0, 10);
         for f in [0.0, 50.0, 500.0] {
             let p = model.impact_envelope_transform(f, 800.0, 3_000.0);
             let expected = Complex64::new(1.0, 0.0) / Complex64::new(1600.0, TAU * f);
@@ -286,6 +343,32 @@ mod tests {
                 (p - expected).norm() < 1e-3 * expected.norm(),
                 "{f}: {p} vs {expected}"
             );
+        }
+    }
+
+    #[test]
+    fn the_envelope_power_is_the_squared_transform() {
+        let freqs = crate::bearing::BearingGeometry::from_catalog("skf-6205-2rs")
+            .unwrap()
+            .fault_frequencies(29.5);
+        for band in [Band::new(2_000.0, 4_000.0), Band::new(500.0, 5_800.0)] {
+            let model = EnvelopeModel::new(FaultKind::InnerRace, &freqs, band, 0.73, 800);
+            for f in [0.0, 3.0, 87.0, 162.2, 590.0, 1_800.0, 3_900.0] {
+                for decay in [60.0, 800.0, 4_000.0] {
+                    for resonance in [1_000.0, 3_000.0, 5_000.0] {
+                        let exact = model
+                            .impact_envelope_transform(f, decay, resonance)
+                            .norm_sqr();
+                        let fast = model.impact_envelope_power(f, decay, resonance);
+                        if exact == 0.0 {
+                            assert_eq!(fast, 0.0);
+                            continue;
+                        }
+                        let error = (fast - exact).abs() / exact;
+                        assert!(error < 1e-9, "{f} {decay} {resonance}: {fast} vs {exact}");
+                    }
+                }
+            }
         }
     }
 
