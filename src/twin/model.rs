@@ -161,7 +161,7 @@ impl EnvelopeModel {
             FaultKind::Ball => freqs.ftf,
             FaultKind::OuterRace | FaultKind::Cage => 0.0,
         };
-        let grid_per_bin = bin_hz / (bins as f64 * bin_hz / GRID_POINTS as f64);
+        let grid_per_bin = bin_hz / grid_step_hz(bins, bin_hz);
         let grid_position = (0..bins)
             .map(|k| {
                 let x = k as f64 * grid_per_bin;
@@ -238,7 +238,7 @@ impl EnvelopeModel {
         let top_hz = self.bins as f64 * self.bin_hz;
         let jitter_power = |f: f64| (-(TAU * f * sigma_t).powi(2)).exp();
         let mut grid = [0f64; GRID_POINTS + 1];
-        let grid_step = top_hz / GRID_POINTS as f64;
+        let grid_step = grid_step_hz(self.bins, self.bin_hz);
         for (i, g) in grid.iter_mut().enumerate() {
             *g = self.impact_envelope_power(
                 i as f64 * grid_step,
@@ -307,6 +307,11 @@ fn load_coefficients_power(coefficients: &[Complex64], l: i32) -> f64 {
 
 /// Points of the coarse grid on which `|P(f)|²` is evaluated.
 const GRID_POINTS: usize = 40;
+
+/// The coarse grid's spacing for a model of `bins` bins of `bin_hz`: it spans the bins.
+fn grid_step_hz(bins: usize, bin_hz: f64) -> f64 {
+    bins as f64 * bin_hz / GRID_POINTS as f64
+}
 
 /// [`hann_kernel`] given `|sin(π δ)|`.
 fn hann_kernel_with_sine(delta: f64, sine: f64) -> f64 {
