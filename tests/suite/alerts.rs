@@ -5,7 +5,7 @@
 use bearingd_testdata::{iox_root, python_iceoryx2, scratch_dir};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 fn bearingd() -> Command {
     Command::new(env!("CARGO_BIN_EXE_bearingd"))
@@ -26,34 +26,43 @@ fn raised_at(stdout: &str) -> u64 {
     line.rsplit(' ').next().unwrap().parse().unwrap()
 }
 
+/// The Python example subscriber (`examples/alerts_subscriber.py`) on `root`, waiting up to
+/// 180 s for the daemon's service and then for `count` alerts. Start it before the daemon.
+///
+/// (why) A daemon it listens to runs in real time, not `--fast`: a fast run of these configs
+/// lives well under a second, and the subscriber, polling every 0.5 s on a loaded 2-core
+/// machine, can miss the service altogether (CI of f8e0a7b: `DoesNotExist` after 180 s). The
+/// service's history covers alerts raised before it connects, as long as the daemon lives.
+pub(crate) fn spawn_python_subscriber(python: &Path, root: &Path, count: usize) -> Child {
+    Command::new(python)
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/alerts_subscriber.py"))
+        .arg("--root")
+        .arg(root)
+        .args(["--count", &count.to_string(), "--timeout", "180"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 #[test]
 fn a_python_subscriber_receives_the_raised_alert_of_a_simulated_fault() {
     let Some(python) = python_iceoryx2() else {
         return;
     };
     let dir = scratch_dir("alerts-python");
-    let data = dir.join("data");
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/alerts_subscriber.py");
-    let root = bearingd::config::Config::embedded_in(&data)
+    let config = fault_from_start_config(&dir, "ip");
+    let root = bearingd::config::load(&config)
         .unwrap()
         .outputs
-        .iceoryx2_root
-        .display()
-        .to_string();
+        .iceoryx2_root;
     // The subscriber first: it waits for the daemon to create the service.
-    let subscriber = Command::new(python)
-        .arg(script)
-        .args(["--root", &root])
-        .args(["--count", "1", "--timeout", "180"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(500));
-    // The embedded default (an outer-race fault from 30 s), as fast as it runs.
+    let subscriber = spawn_python_subscriber(&python, &root, 1);
+    // An outer-race fault from the start, in real time (see `spawn_python_subscriber`): raised
+    // at about 14 s of 16.
     let daemon = bearingd()
-        .args(["run", "--fast", "--duration", "70", "--quiet", "--data-dir"])
-        .arg(&data)
+        .args(["run", "--duration", "16", "--quiet", "--config"])
+        .arg(&config)
         .output()
         .unwrap();
     let stdout = String::from_utf8_lossy(&daemon.stdout);
@@ -63,8 +72,8 @@ fn a_python_subscriber_receives_the_raised_alert_of_a_simulated_fault() {
         String::from_utf8_lossy(&daemon.stderr)
     );
     let sample = raised_at(&stdout);
-    // Raised once the band selection's evidence (10 s, all of it faulty) names the fault: at
-    // watch or straight at alarm, then perhaps escalated; the subscriber asked for the first.
+    // Raised once the band selection's evidence names the fault: at watch or straight at alarm,
+    // then perhaps escalated; the subscriber asked for the first.
     assert!(
         stdout.contains("1 alerts published") || stdout.contains("2 alerts published"),
         "{stdout}"
@@ -99,10 +108,11 @@ fn a_python_subscriber_receives_the_raised_alert_of_a_simulated_fault() {
 }
 
 /// A config with one simulated sensor whose outer race is faulty from the start, files in
-/// `dir`, the iceoryx2 root under the target dir (the config refuses /tmp).
-fn fault_from_start_config(dir: &Path) -> PathBuf {
+/// `dir`, the iceoryx2 root under the target dir (the config refuses /tmp), one per `iox_tag`
+/// (tests running at once must not share an alert service).
+fn fault_from_start_config(dir: &Path, iox_tag: &str) -> PathBuf {
     // Short: iceoryx2's socket paths below it must fit in 108 bytes.
-    let iox = iox_root(env!("CARGO_TARGET_TMPDIR"), "ia");
+    let iox = iox_root(env!("CARGO_TARGET_TMPDIR"), iox_tag);
     let text = format!(
         r#"
 [[sensors]]
@@ -149,7 +159,7 @@ fn terminate(daemon: Child) -> std::process::Output {
 #[test]
 fn bearingd_alerts_prints_live_alerts_and_a_late_subscriber_gets_the_active_ones() {
     let dir = scratch_dir("alerts-cli");
-    let config = fault_from_start_config(&dir);
+    let config = fault_from_start_config(&dir, "ia");
     let daemon = bearingd()
         .args(["run", "--quiet", "--config"])
         .arg(&config)

@@ -179,26 +179,15 @@ fn the_daemon_raises_logs_publishes_and_replays_an_unbalance() {
     let root = bearingd::config::load(&config)
         .unwrap()
         .outputs
-        .iceoryx2_root
-        .display()
-        .to_string();
-    let script =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/alerts_subscriber.py");
+        .iceoryx2_root;
     // The subscriber first: it waits for the daemon to create the service. Two alerts: the
-    // velocity zone flag and the unbalance both rise in zone C.
-    let subscriber = std::process::Command::new(py_iox)
-        .arg(script)
-        .args(["--root", &root, "--count", "2", "--timeout", "180"])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(500));
+    // velocity zone flag and the unbalance both rise in zone C. The daemon in real time (see
+    // `spawn_python_subscriber`).
+    let subscriber = crate::alerts::spawn_python_subscriber(&py_iox, &root, 2);
     let stdout = crate::severity::run_ok(&[
         "run",
         "--config",
         config.to_str().unwrap(),
-        "--fast",
         "--duration",
         "30",
         "--quiet",
