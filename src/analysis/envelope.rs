@@ -10,6 +10,7 @@
 //! every window the same way. All buffers are allocated at construction; nothing allocates per window.
 
 use super::band::Band;
+use super::real_fft::{RealFftBuffers, RealForwardFft};
 use realfft::{RealFftPlanner, RealToComplex};
 use rustfft::num_complex::Complex32;
 use rustfft::{Fft, FftPlanner};
@@ -21,6 +22,7 @@ use std::sync::Arc;
 pub struct FftPlans {
     complex: FftPlanner<f32>,
     real: RealFftPlanner<f32>,
+    window: HashMap<usize, Arc<RealForwardFft>>,
     hann: HashMap<usize, Arc<[f32]>>,
 }
 
@@ -29,6 +31,7 @@ impl Default for FftPlans {
         FftPlans {
             complex: FftPlanner::new(),
             real: RealFftPlanner::new(),
+            window: HashMap::new(),
             hann: HashMap::new(),
         }
     }
@@ -70,6 +73,15 @@ impl FftPlans {
 
     fn real_forward(&mut self, len: usize) -> Arc<dyn RealToComplex<f32>> {
         self.real.plan_fft_forward(len)
+    }
+
+    /// The cached window transform of `len` samples ([`RealForwardFft`]).
+    fn window_forward(&mut self, len: usize) -> Arc<RealForwardFft> {
+        let complex = &mut self.complex;
+        self.window
+            .entry(len)
+            .or_insert_with(|| Arc::new(RealForwardFft::new(len, complex)))
+            .clone()
     }
 }
 
@@ -127,42 +139,31 @@ pub fn hann(len: usize) -> Vec<f32> {
 
 /// The real FFT of one analysis window of raw samples.
 pub struct WindowTransform {
-    fft: Arc<dyn RealToComplex<f32>>,
-    input: Vec<f32>,
-    spectrum: Vec<Complex32>,
-    scratch: Vec<Complex32>,
+    fft: Arc<RealForwardFft>,
+    buffers: RealFftBuffers,
 }
 
 impl WindowTransform {
     pub fn new(window: usize, plans: &mut FftPlans) -> Self {
-        let fft = plans.real_forward(window);
+        let fft = plans.window_forward(window);
         WindowTransform {
-            input: fft.make_input_vec(),
-            spectrum: fft.make_output_vec(),
-            scratch: fft.make_scratch_vec(),
+            buffers: fft.buffers(),
             fft,
         }
     }
 
     pub fn window(&self) -> usize {
-        self.input.len()
+        self.fft.samples()
     }
 
     /// Transforms the window formed by `older` followed by `newer` (the two halves of a ring
     /// buffer, or one slice and an empty one); their lengths must add up to the window.
     pub fn transform(&mut self, older: &[f32], newer: &[f32]) -> &[Complex32] {
-        debug_assert_eq!(older.len() + newer.len(), self.input.len());
-        self.input[..older.len()].copy_from_slice(older);
-        self.input[older.len()..].copy_from_slice(newer);
-        // Lengths match by construction, so the transform cannot fail.
-        let _ =
-            self.fft
-                .process_with_scratch(&mut self.input, &mut self.spectrum, &mut self.scratch);
-        &self.spectrum
+        self.fft.transform(older, newer, &mut self.buffers)
     }
 
     pub fn spectrum(&self) -> &[Complex32] {
-        &self.spectrum
+        self.buffers.spectrum()
     }
 }
 

@@ -6,6 +6,7 @@
 //! allocate per hop.
 //!
 //! - [`envelope`]: squared-envelope spectrum, batch (Welch) and rolling.
+//! - [`real_fft`]: the real FFT of a window, split in vector instructions.
 //! - [`kurtogram`]: the band tree, spectral kurtosis, GK index, per-band spectra.
 //! - [`fault_bands`]: fault-frequency scores with slip tolerance and sidebands.
 //! - [`modulation`]: shaft- or cage-rate sidebands around a comb's peaks (ball or inner race).
@@ -37,6 +38,7 @@ pub mod kurtogram;
 pub mod machine;
 pub mod modulation;
 pub mod monitor;
+pub mod real_fft;
 pub mod record;
 pub mod rolling_element;
 pub mod settings;
