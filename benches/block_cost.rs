@@ -13,8 +13,12 @@
 //! the alert rows as an upper bound, and the window row as the per-window analysis. The inputs
 //! are seeded: two builds on one machine compare fairly.
 //!
+//! Unpaced, this bench hands blocks over back to back, with the caches warm from the block
+//! before and the band selections' thread always behind; `BENCH_PACE=4` feeds the signal at 4×
+//! real time, closer to a daemon's situation (with margin): use it to compare two builds.
+//!
 //! Run: `cargo bench --bench block_cost` (`BENCH_SENSORS`, default 16; `BENCH_SECONDS` of
-//! signal, default 60).
+//! signal, default 60; `BENCH_PACE`, times real time, default 0: unpaced).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
@@ -34,6 +38,9 @@ fn config_text(sensors: usize) -> String {
         + &simulated_sensors(sensors, 25_600, |_| 0.0, CHATTERING_IMBALANCE_G)
 }
 
+/// Rounds of 0.1 s left out of the figures.
+const WARM_UP_ROUNDS: usize = 20;
+
 fn report(what: &str, mut values_us: Vec<f64>) {
     values_us.sort_by(f64::total_cmp);
     println!(
@@ -52,6 +59,7 @@ fn main() {
     }
     let sensors = env_or("BENCH_SENSORS", 16);
     let seconds = env_or("BENCH_SECONDS", 60);
+    let pace = env_or("BENCH_PACE", 0);
     let config = parse(&config_text(sensors), "block_cost bench").expect("bench config");
     let mut sources: Vec<SimSource> = config
         .sensors
@@ -63,7 +71,12 @@ fn main() {
         .collect();
     let mut pipeline = Pipeline::new(&config, &BTreeMap::new(), None);
     let (mut quiet, mut window, mut to_flag, mut deciding) = (vec![], vec![], vec![], vec![]);
-    for _ in 0..seconds * 10 {
+    let start = Instant::now();
+    for round in 0..seconds * 10 {
+        if pace > 0 {
+            let due = std::time::Duration::from_secs_f64(round as f64 * 0.1 / pace as f64);
+            std::thread::sleep(due.saturating_sub(start.elapsed()));
+        }
         for source in &mut sources {
             for input in source.next_blocks() {
                 let started = Instant::now();
@@ -84,6 +97,11 @@ fn main() {
                     }
                 });
                 let took_us = started.elapsed().as_secs_f64() * 1e6;
+                // The first 2 s are left out: every channel's first window (cold caches, and
+                // no earlier window whose report it carries) closes in them.
+                if round < WARM_UP_ROUNDS {
+                    continue;
+                }
                 match (windows, first_flag_us) {
                     (0, _) => quiet.push(took_us),
                     (_, None) => window.push(took_us),
