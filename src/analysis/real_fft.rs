@@ -176,16 +176,11 @@ fn split_pairs(low: &mut [Complex32], high: &mut [Complex32], tw_re: &[f32], tw_
         let mut high_re = [0f32; LANES];
         let mut high_im = [0f32; LANES];
         for i in 0..LANES {
-            let (sum_re, sum_im) = (a_re[i] + b_re[i], a_im[i] + b_im[i]);
-            let (diff_re, diff_im) = (a_re[i] - b_re[i], a_im[i] - b_im[i]);
-            let half_sum_re = 0.5 * sum_re;
-            let half_diff_im = 0.5 * diff_im;
-            let twiddled_re = sum_im * tr[i] + diff_re * ti[i];
-            let twiddled_im = sum_im * ti[i] - diff_re * tr[i];
-            low_re[i] = half_sum_re + twiddled_re;
-            low_im[i] = half_diff_im + twiddled_im;
-            high_re[i] = half_sum_re - twiddled_re;
-            high_im[i] = twiddled_im - half_diff_im;
+            let a = Complex32::new(a_re[i], a_im[i]);
+            let b = Complex32::new(b_re[i], b_im[i]);
+            let (low_bin, high_bin) = split_one(a, b, tr[i], ti[i]);
+            (low_re[i], low_im[i]) = (low_bin.re, low_bin.im);
+            (high_re[i], high_im[i]) = (high_bin.re, high_bin.im);
         }
         for (i, c) in lo.iter_mut().enumerate() {
             *c = Complex32::new(low_re[i], low_im[i]);
@@ -209,8 +204,8 @@ fn split_pairs(low: &mut [Complex32], high: &mut [Complex32], tw_re: &[f32], tw_
 
 /// One pair: `a` = Z[k], `b` = Z[N/2 − k] of the half-length transform Z, `(tr, ti)` =
 /// ½ e^{-2πik/N}; returns bins k and N/2 − k of the real signal. realfft's expressions, in its
-/// order, so that the rounding is the same (the [`LANES`]-pair loop of [`split_pairs`] spells the
-/// same steps out).
+/// order, so that the rounding is the same.
+#[inline(always)]
 fn split_one(a: Complex32, b: Complex32, tr: f32, ti: f32) -> (Complex32, Complex32) {
     let (sum_re, sum_im) = (a.re + b.re, a.im + b.im);
     let (diff_re, diff_im) = (a.re - b.re, a.im - b.im);
