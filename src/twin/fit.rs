@@ -150,7 +150,7 @@ impl TwinFitter {
         let nominal = fault.frequency(freqs);
         let top = fit_range_hz(nominal, self.bounds.slip).min(measured.band.width_hz());
         let bins = ((top / measured.bin_hz).floor() as usize + 1).min(measured.amplitude.len());
-        let model = EnvelopeModel::new(fault, freqs, measured.band, measured.bin_hz, bins);
+        let mut model = EnvelopeModel::new(fault, freqs, measured.band, measured.bin_hz, bins);
         self.twin.resize(bins, 0.0);
         self.noise.resize(bins, 0.0);
         self.measured.clear();
@@ -194,7 +194,7 @@ impl TwinFitter {
             let f_d = scan_lo + (scan_hi - scan_lo) * i as f64 / (steps - 1) as f64;
             let e = self
                 .evaluate(
-                    &model,
+                    &mut model,
                     &ShapeParams {
                         impact_rate_hz: f_d,
                         ..shape
@@ -211,7 +211,7 @@ impl TwinFitter {
 
         // Decay, jitter and noise ratio on the unit cube.
         let ratio_log_range = (-9.0, 9.0);
-        let start_ratio = self.evaluate(&model, &shape, None);
+        let start_ratio = self.evaluate(&mut model, &shape, None);
         let start_log_ratio = if start_ratio.twin > 0.0 && start_ratio.noise > 0.0 {
             (start_ratio.noise / start_ratio.twin)
                 .log10()
@@ -247,7 +247,7 @@ impl TwinFitter {
             let budget = if round == 0 { 120 } else { 60 };
             let (p, _, n) = nelder_mead(to_cube(&base, log_ratio), step, budget, 1e-7, |p| {
                 let (s, r) = from_cube(p, &base);
-                self.evaluate(&model, &s, Some(10f64.powf(r))).error
+                self.evaluate(&mut model, &s, Some(10f64.powf(r))).error
             });
             evaluations += n;
             (shape, log_ratio) = from_cube(&p, &base);
@@ -264,7 +264,7 @@ impl TwinFitter {
             |f_d| {
                 evaluations += 1;
                 self.evaluate(
-                    &model,
+                    &mut model,
                     &ShapeParams {
                         impact_rate_hz: f_d,
                         ..shape
@@ -275,7 +275,7 @@ impl TwinFitter {
             },
         );
         shape.impact_rate_hz = f_d.clamp(nominal * (1.0 - slip), nominal * (1.0 + slip));
-        let scales = self.evaluate(&model, &shape, Some(ratio));
+        let scales = self.evaluate(&mut model, &shape, Some(ratio));
         evaluations += 1;
         HypothesisFit {
             fault,
@@ -304,7 +304,7 @@ impl TwinFitter {
         params: &TwinParams,
         out: &mut [f64],
     ) {
-        let model = EnvelopeModel::new(fault, freqs, band, bin_hz, out.len());
+        let mut model = EnvelopeModel::new(fault, freqs, band, bin_hz, out.len());
         self.noise.resize(out.len(), 0.0);
         model.basis(&params.shape(), out, &mut self.noise);
         let twin_scale = params.a.powi(4);
@@ -318,7 +318,7 @@ impl TwinFitter {
     /// fit in the power domain.
     fn evaluate(
         &mut self,
-        model: &EnvelopeModel,
+        model: &mut EnvelopeModel,
         shape: &ShapeParams,
         ratio: Option<f64>,
     ) -> Scales {

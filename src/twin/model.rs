@@ -70,7 +70,45 @@ pub struct EnvelopeModel {
     grid_position: Vec<(usize, f64)>,
     /// The noise shape `N` per bin (fixed per model).
     noise_shape: Vec<f64>,
+    /// `|P(f)|²` on the coarse grid for the last decay and resonance asked for.
+    grid: TransformGrid,
+    /// Where the last impact rate's lines fall and how their Hann kernels spread them.
+    lines: LineLayout,
 }
+
+/// `|P(f)|²` at the points of the coarse grid, for one decay and resonance. The impact-rate
+/// scans keep both fixed, so they reuse it.
+#[derive(Debug, Clone)]
+struct TransformGrid {
+    /// `(decay, resonance)` the values belong to (NaN before the first use).
+    key: (f64, f64),
+    values: [f64; GRID_POINTS + 1],
+}
+
+/// The lines `m·f_d + l·f_mod` of one impact rate with their Hann kernels' weights on the
+/// bins: they depend on `f_d` alone, and a Nelder–Mead search over the decay, the jitter and
+/// the noise keeps `f_d` fixed for hundreds of evaluations, so the positions, sines and
+/// kernels are computed once per impact rate instead of once per evaluation.
+#[derive(Debug, Clone)]
+struct LineLayout {
+    /// The impact rate the lines belong to (NaN before the first use).
+    impact_rate_hz: f64,
+    lines: Vec<PlacedLine>,
+}
+
+/// One line: its frequency, the power of its load coefficient, and the weights of its Hann
+/// kernel on the bins `first_bin ..` (at most `2·KERNEL_HALF_WIDTH + 1`, fewer at the edges).
+#[derive(Debug, Clone, Copy)]
+struct PlacedLine {
+    f: f64,
+    load_power: f64,
+    first_bin: usize,
+    taps: usize,
+    weights: [f64; KERNEL_TAPS],
+}
+
+/// Bins a line's kernel can reach.
+const KERNEL_TAPS: usize = 2 * KERNEL_HALF_WIDTH as usize + 1;
 
 /// The squared load `q²` over the modulation, in Fourier coefficients: the same for every
 /// model with (or every model without) a modulation, so computed once per process.
@@ -182,6 +220,14 @@ impl EnvelopeModel {
             load: LoadSpectrum::of(modulation_hz > 0.0),
             grid_position,
             noise_shape,
+            grid: TransformGrid {
+                key: (f64::NAN, f64::NAN),
+                values: [0.0; GRID_POINTS + 1],
+            },
+            lines: LineLayout {
+                impact_rate_hz: f64::NAN,
+                lines: Vec::new(),
+            },
         }
     }
 
@@ -229,23 +275,18 @@ impl EnvelopeModel {
     ///
     /// `|P(f)|²` is smooth in `f` (its scale is the decay rate, hundreds of Hz), so it is
     /// evaluated on a coarse grid and interpolated; this keeps an evaluation at a few
-    /// microseconds.
-    pub fn basis(&self, params: &ShapeParams, twin: &mut [f64], noise: &mut [f64]) {
+    /// microseconds. The grid and the lines' kernels are kept between calls while the
+    /// parameters they depend on stay the same (the values are those a fresh model gives).
+    pub fn basis(&mut self, params: &ShapeParams, twin: &mut [f64], noise: &mut [f64]) {
         debug_assert!(twin.len() == self.bins && noise.len() == self.bins);
         twin.iter_mut().for_each(|v| *v = 0.0);
         let f_d = params.impact_rate_hz;
         let sigma_t = params.jitter / f_d.max(1e-9);
-        let top_hz = self.bins as f64 * self.bin_hz;
         let jitter_power = |f: f64| (-(TAU * f * sigma_t).powi(2)).exp();
-        let mut grid = [0f64; GRID_POINTS + 1];
+        self.update_grid(params.decay_per_s, params.resonance_hz);
+        self.update_lines(f_d);
+        let grid = &self.grid.values;
         let grid_step = grid_step_hz(self.bins, self.bin_hz);
-        for (i, g) in grid.iter_mut().enumerate() {
-            *g = self.impact_envelope_power(
-                i as f64 * grid_step,
-                params.decay_per_s,
-                params.resonance_hz,
-            );
-        }
         let transform_power = |f: f64| {
             let x = (f / grid_step).clamp(0.0, GRID_POINTS as f64);
             let i = (x as usize).min(GRID_POINTS - 1);
@@ -253,18 +294,13 @@ impl EnvelopeModel {
             grid[i] * (1.0 - t) + grid[i + 1] * t
         };
 
-        // Lines at m·f_d + l·f_mod.
-        let max_m = (top_hz / f_d).ceil() as i32 + 1;
-        let orders = self.load.orders;
-        for m in 0..=max_m {
-            for l in -orders..=orders {
-                let f = f64::from(m) * f_d + f64::from(l) * self.modulation_hz;
-                if f <= 0.5 * self.bin_hz || f >= top_hz {
-                    continue;
+        for line in &self.lines.lines {
+            let power =
+                4.0 * line.load_power * f_d * f_d * transform_power(line.f) * jitter_power(line.f);
+            if let Some(bins) = twin.get_mut(line.first_bin..line.first_bin + line.taps) {
+                for (slot, weight) in bins.iter_mut().zip(&line.weights) {
+                    *slot += power * weight;
                 }
-                let q = load_coefficients_power(&self.load.coefficients, l);
-                let power = 4.0 * q * f_d * f_d * transform_power(f) * jitter_power(f);
-                self.spread_line(f, power, twin);
             }
         }
         // The continuum the jitter makes.
@@ -283,22 +319,74 @@ impl EnvelopeModel {
         twin[0] = 0.0;
     }
 
-    /// Adds a line of `power` at `f` to the bins its Hann kernel reaches. `sin(π(k − c))` has
-    /// the same magnitude for every bin `k`, so one sine serves the whole kernel.
-    fn spread_line(&self, f: f64, power: f64, out: &mut [f64]) {
-        let centre = f / self.bin_hz;
-        let nearest = centre.round();
-        let sine = (PI * (centre - nearest)).sin().abs();
-        for j in -KERNEL_HALF_WIDTH..=KERNEL_HALF_WIDTH {
-            let k = nearest + f64::from(j);
-            if k < 1.0 {
-                continue;
-            }
-            if let Some(slot) = out.get_mut(k as usize) {
-                *slot += power * hann_kernel_with_sine(k - centre, sine);
+    /// `|P(f)|²` on the coarse grid for `decay` and `resonance`, unless it holds them already.
+    fn update_grid(&mut self, decay: f64, resonance: f64) {
+        if self.grid.key == (decay, resonance) {
+            return;
+        }
+        let grid_step = grid_step_hz(self.bins, self.bin_hz);
+        let mut values = [0f64; GRID_POINTS + 1];
+        for (i, g) in values.iter_mut().enumerate() {
+            *g = self.impact_envelope_power(i as f64 * grid_step, decay, resonance);
+        }
+        self.grid = TransformGrid {
+            key: (decay, resonance),
+            values,
+        };
+    }
+
+    /// Places the lines of impact rate `f_d` on the model's bins, unless they are placed
+    /// already.
+    fn update_lines(&mut self, f_d: f64) {
+        if self.lines.impact_rate_hz == f_d {
+            return;
+        }
+        let top_hz = self.bins as f64 * self.bin_hz;
+        let max_m = (top_hz / f_d).ceil() as i32 + 1;
+        let orders = self.load.orders;
+        self.lines.lines.clear();
+        for m in 0..=max_m {
+            for l in -orders..=orders {
+                let f = f64::from(m) * f_d + f64::from(l) * self.modulation_hz;
+                if f <= 0.5 * self.bin_hz || f >= top_hz {
+                    continue;
+                }
+                let load_power = load_coefficients_power(&self.load.coefficients, l);
+                if let Some(line) = place_line(f, load_power, self.bin_hz, self.bins) {
+                    self.lines.lines.push(line);
+                }
             }
         }
+        self.lines.impact_rate_hz = f_d;
     }
+}
+
+/// A line of frequency `f` on `bins` bins of `bin_hz`: the bins its Hann kernel reaches (from
+/// bin 1) and its weight on each. `sin(π(k − c))` has the same magnitude for every bin `k`, so
+/// one sine serves the whole kernel. `None` when the kernel reaches no bin.
+fn place_line(f: f64, load_power: f64, bin_hz: f64, bins: usize) -> Option<PlacedLine> {
+    let centre = f / bin_hz;
+    let nearest = centre.round();
+    let sine = (PI * (centre - nearest)).sin().abs();
+    let mut line = PlacedLine {
+        f,
+        load_power,
+        first_bin: 0,
+        taps: 0,
+        weights: [0.0; KERNEL_TAPS],
+    };
+    for j in -KERNEL_HALF_WIDTH..=KERNEL_HALF_WIDTH {
+        let k = nearest + f64::from(j);
+        if k < 1.0 || k as usize >= bins {
+            continue;
+        }
+        if line.taps == 0 {
+            line.first_bin = k as usize;
+        }
+        line.weights[line.taps] = hann_kernel_with_sine(k - centre, sine);
+        line.taps += 1;
+    }
+    (line.taps > 0).then_some(line)
 }
 
 fn load_coefficients_power(coefficients: &[Complex64], l: i32) -> f64 {
@@ -373,6 +461,48 @@ mod tests {
                         assert!(error < 1e-9, "{f} {decay} {resonance}: {fast} vs {exact}");
                     }
                 }
+            }
+        }
+    }
+
+    /// The grid and the lines kept between calls give what a fresh model gives, bit for bit,
+    /// whichever parameters changed since (the fits compare errors to the last digit).
+    #[test]
+    fn a_reused_model_gives_a_fresh_models_basis() {
+        let freqs = crate::bearing::BearingGeometry::from_catalog("skf-6205-2rs")
+            .unwrap()
+            .fault_frequencies(29.5);
+        let band = Band::new(2_000.0, 4_500.0);
+        let shape = |f_d: f64, decay: f64, resonance: f64, jitter: f64| ShapeParams {
+            impact_rate_hz: f_d,
+            decay_per_s: decay,
+            resonance_hz: resonance,
+            jitter,
+        };
+        let sequence = [
+            shape(162.0, 800.0, 3_000.0, 0.01),
+            shape(162.0, 800.0, 3_000.0, 0.02), // jitter only: grid and lines kept
+            shape(162.0, 650.0, 3_000.0, 0.02), // decay: the grid changes
+            shape(163.5, 650.0, 3_000.0, 0.02), // impact rate: the lines change
+            shape(163.5, 650.0, 3_400.0, 0.02), // resonance: the grid changes
+            shape(162.0, 800.0, 3_000.0, 0.01), // back to the first
+        ];
+        for fault in [FaultKind::OuterRace, FaultKind::InnerRace, FaultKind::Ball] {
+            let bins = 900;
+            let mut reused = EnvelopeModel::new(fault, &freqs, band, 1.83, bins);
+            for params in &sequence {
+                let (mut twin, mut noise) = (vec![0.0; bins], vec![0.0; bins]);
+                reused.basis(params, &mut twin, &mut noise);
+                let mut fresh = EnvelopeModel::new(fault, &freqs, band, 1.83, bins);
+                let (mut twin_fresh, mut noise_fresh) = (vec![0.0; bins], vec![0.0; bins]);
+                fresh.basis(params, &mut twin_fresh, &mut noise_fresh);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&twin), bits(&twin_fresh), "{fault:?} {params:?}");
+                assert_eq!(bits(&noise), bits(&noise_fresh), "{fault:?} {params:?}");
+                assert!(
+                    twin.iter().any(|&t| t > 0.0),
+                    "{fault:?}: an empty twin proves nothing"
+                );
             }
         }
     }
