@@ -1,14 +1,14 @@
 //! The forward FFT of a real signal of N samples, as the daemon's window transform needs it.
 //!
 //! For an even N (every window the daemon takes), the N samples are read as N/2 complex pairs,
-//! transformed by one complex FFT of N/2 points (rustfft), and one pass splits that into the N/2 + 1 bins of the real signal: bin k and bin
-//! N/2 − k come from the same two values. (why) realfft does the same, but its pass is a scalar
-//! loop walking the two halves towards each other; on the daemon's 32,768-sample window it took
-//! more instructions than the complex FFT itself (callgrind, docs/PERFORMANCE.md). This pass
-//! does realfft's arithmetic in realfft's order, on 64 pairs at a time laid out so that the
-//! compiler makes vector instructions of it. An odd N is transformed as realfft does it, by a
-//! complex FFT of N points. Its bins equal realfft's bit for bit (tested below), so no decision
-//! can change.
+//! transformed by one complex FFT of N/2 points (rustfft), and one pass splits that into the
+//! N/2 + 1 bins of the real signal: bin k and bin N/2 − k come from the same two values.
+//! (why) realfft does the same, but its pass is a scalar loop walking the two halves towards
+//! each other; on the daemon's 32,768-sample window it took more instructions than the complex
+//! FFT itself (callgrind, docs/PERFORMANCE.md). This pass does realfft's arithmetic in
+//! realfft's order, on 64 pairs at a time laid out so that the compiler makes vector
+//! instructions of it. An odd N is transformed as realfft does it, by a complex FFT of N
+//! points. Its bins equal realfft's bit for bit (tested below), so no decision can change.
 
 use rustfft::num_complex::Complex32;
 use rustfft::{Fft, FftPlanner};
@@ -149,8 +149,8 @@ impl RealForwardFft {
 }
 
 /// realfft's split of each pair (`low[j]`, bin j + 1, with `high[pairs − 1 − j]`, bin
-/// N/2 − j − 1): [`LANES`] pairs at a time gathered into arrays the compiler vectorises, the rest
-/// one by one, the same arithmetic in both.
+/// N/2 − j − 1): [`LANES`] pairs at a time gathered into arrays the compiler vectorises, the
+/// rest one by one, the same arithmetic in both.
 fn split_pairs(low: &mut [Complex32], high: &mut [Complex32], tw_re: &[f32], tw_im: &[f32]) {
     let low_chunks = low.chunks_exact_mut(LANES);
     let high_chunks = high.rchunks_exact_mut(LANES);
@@ -225,8 +225,8 @@ mod tests {
     use realfft::RealFftPlanner;
 
     /// Bit for bit realfft's bins, on even lengths with and without a middle pair and with
-    /// remainders of the 64-pair loop (32,768: 127 groups and 63 pairs), on odd lengths, on noise with a DC offset, split in
-    /// two slices at an odd and at an even place.
+    /// remainders of the 64-pair loop (32,768: 127 groups and 63 pairs), on odd lengths, on noise
+    /// with a DC offset, split in two slices at an odd and at an even place.
     #[test]
     fn its_bins_equal_realffts_bit_for_bit() {
         let mut planner = FftPlanner::new();
