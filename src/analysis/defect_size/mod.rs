@@ -54,7 +54,7 @@ use crate::bearing::{BearingGeometry, FaultKind, Race};
 use average::Average;
 use events::Events;
 use rustfft::num_complex::Complex64;
-use rustfft::FftPlanner;
+use rustfft::FftPlannerScalar;
 use serde::Serialize;
 use std::f64::consts::TAU;
 
@@ -236,15 +236,17 @@ pub fn measure_defect_size(
     })
 }
 
-/// Complex FFTs of any length, planned once per length.
+/// Complex FFTs of any length, planned once per length. The scalar planner: this runs once per
+/// `analyze`, off the window path, and rustfft's SSE and AVX kernels in `f64` would be about
+/// 0.4 MB of the service binary for it (docs/PERFORMANCE.md "Service binary").
 struct Fft {
-    planner: FftPlanner<f64>,
+    planner: FftPlannerScalar<f64>,
 }
 
 impl Default for Fft {
     fn default() -> Self {
         Fft {
-            planner: FftPlanner::new(),
+            planner: FftPlannerScalar::new(),
         }
     }
 }
