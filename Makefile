@@ -3,7 +3,7 @@
 #   make install                      build (cargo build --release --locked) and install under /usr
 #                                     the service bearingd and the lab bearingd-lab
 #   make install-service              the service alone (edge boxes: no training, no plots)
-#   make install BIN=path/to/bearingd install an already built binary (e.g. a static musl build);
+#   make install BIN=path/to/bearingd install an already built binary (e.g. a cross-built one);
 #                                     LAB_BIN=path/to/bearingd-lab likewise for the lab
 #   make install DESTDIR=/srv/root    stage into another root (packaging, VM images)
 #   make uninstall                    remove what install put there (not the config, logs, user)

@@ -22,7 +22,7 @@
 #
 # usage: tests/vm/can_vm_test.sh [workdir]   (default target/can-vm); CAN_VM_CASES="run fd" runs
 # only those cases (for iterating; the capture check needs classic and fd). Needs root for apt-get when
-# qemu, musl-tools or the musl target are missing; with CI=true a missing piece is a failure.
+# qemu or strip are missing; with CI=true a missing piece is a failure.
 set -euo pipefail
 CASES=${CAN_VM_CASES:-classic fd malformed restart run}
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
@@ -34,7 +34,7 @@ NAME=can-vm
 . "$ROOT/tests/vm/common.sh"
 
 # 1. Host tools.
-vm_host_tools
+vm_host_tools strip:binutils
 python=${PYTHON:-$ROOT/.venv/bin/python}
 [ -x "$python" ] || python=python3
 "$python" -c 'import cantools' 2>/dev/null ||
@@ -43,7 +43,7 @@ python=${PYTHON:-$ROOT/.venv/bin/python}
 # 2. Kernel and busybox.
 vm_kernel
 
-# 3. Static binaries, the build every VM test shares (common.sh).
+# 3. The test step's bearingd and firmware-sim (common.sh).
 vm_binaries
 
 # 4. initramfs.
@@ -57,9 +57,8 @@ done
 for m in net/can/can.ko net/can/can-raw.ko drivers/net/can/dev/can-dev.ko drivers/net/can/vcan.ko; do
   cp "$MODDIR/$m" "$IR/lib/modules/"
 done
-# Stripped: the release profile's debug info would only fatten the initramfs.
-strip -o "$IR/bin/bearingd" "$MUSL_BIN/bearingd"
-strip -o "$IR/bin/firmware-sim" "$MUSL_BIN/firmware-sim"
+vm_install_binary "$HOST_BIN/bearingd" "$IR"
+vm_install_binary "$HOST_BIN/firmware-sim" "$IR"
 mkdir -p "$IR/etc"
 cp "$ROOT/tests/vm/run.toml" "$IR/etc/bearingd-run.toml"
 cp "$ROOT/tests/vm/init.sh" "$IR/init"

@@ -10,12 +10,11 @@ missing() {
   exit 1
 }
 
-# vm_host_tools [COMMAND:PACKAGE ...]: qemu, musl-gcc and the Rust musl target, plus each
-# COMMAND (from Debian's PACKAGE); installed here when root.
+# vm_host_tools [COMMAND:PACKAGE ...]: qemu, plus each COMMAND (from Debian's PACKAGE);
+# installed here when root.
 vm_host_tools() {
   local need_apt=() pair
   command -v qemu-system-x86_64 >/dev/null || need_apt+=(qemu-system-x86)
-  command -v musl-gcc >/dev/null || need_apt+=(musl-tools)
   for pair in "$@"; do
     command -v "${pair%%:*}" >/dev/null || need_apt+=("${pair#*:}")
   done
@@ -25,9 +24,6 @@ vm_host_tools() {
     apt-get install -y -q --no-install-recommends "${need_apt[@]}" >/dev/null ||
       missing "${need_apt[*]}" "apt-get update && apt-get install ${need_apt[*]}"
   fi
-  rustup target list --installed | grep -q x86_64-unknown-linux-musl ||
-    rustup target add x86_64-unknown-linux-musl >/dev/null ||
-    missing "Rust target x86_64-unknown-linux-musl" "rustup target add x86_64-unknown-linux-musl"
 }
 
 # vm_kernel: Debian's current kernel package and busybox-static, downloaded and unpacked (not
@@ -49,15 +45,31 @@ vm_kernel() {
   BB=$WORK/bbroot/bin/busybox
 }
 
-# vm_binaries: the static (musl) bearingd and firmware-sim every VM test runs, built by one
-# cargo command with the default features (SocketCAN, iceoryx2, TLS) so that the three VM
-# tests share one build: the first builds (about 5 min on 2 cores), the next two find it
-# done. A different package set or feature list would unify features differently and rebuild
-# every crate whose features changed. Sets MUSL_BIN, the directory of both binaries. A failed
-# build stops the calling script (set -e) with cargo's errors above.
+# vm_binaries: the bearingd and firmware-sim every VM test runs are the host build of the test
+# step (`cargo test --workspace --release`, default features: SocketCAN, iceoryx2, TLS), so the
+# VMs run what the tests ran and, in CI, nothing is compiled here (a musl build of its own cost
+# CI 335 s). The same cargo command as the test step, so it unifies features as that step does
+# and finds its build done; by hand, the first VM test builds it. Sets HOST_BIN, the directory
+# of both binaries. A failed build stops the calling script (set -e) with cargo's errors above.
 vm_binaries() {
-  say "cargo build --release --locked (musl: bearingd, firmware-sim; shared by the VM tests)"
-  (cd "$ROOT" && cargo build --release --locked --quiet --target x86_64-unknown-linux-musl \
-    -p bearingd -p firmware-sim)
-  MUSL_BIN=$ROOT/target/x86_64-unknown-linux-musl/release
+  say "cargo test --workspace --release --no-run (the test step's build: bearingd, firmware-sim)"
+  (cd "$ROOT" && cargo test --workspace --release --locked --quiet --no-run)
+  HOST_BIN=$ROOT/target/release
+  local bin
+  for bin in bearingd firmware-sim; do
+    [ -x "$HOST_BIN/$bin" ] || missing "$HOST_BIN/$bin" "cargo test --workspace --release --no-run"
+  done
+}
+
+# vm_install_binary BINARY ROOT: BINARY stripped (the release profile's line tables would only
+# fatten the initramfs) into ROOT/bin, with every shared library it links (glibc's loader, libc,
+# libm, libgcc_s, as ldd lists them) at the same path under ROOT: the busybox VMs have no C
+# library of their own, and the VM's kernel runs the host's Debian 12 userland as it is.
+vm_install_binary() {
+  local binary=$1 root=$2 lib
+  mkdir -p "$root/bin"
+  strip -o "$root/bin/$(basename "$binary")" "$binary"
+  for lib in $(ldd "$binary" | grep -o '/[^ ]*'); do
+    cp -L --parents "$lib" "$root"
+  done
 }

@@ -29,7 +29,7 @@ NAME=power-vm
 . "$ROOT/tests/vm/common.sh"
 
 # 1. Host tools (e2fsprogs: the file system, the journal replay and the copy out of the image).
-vm_host_tools mkfs.ext4:e2fsprogs e2fsck:e2fsprogs debugfs:e2fsprogs
+vm_host_tools mkfs.ext4:e2fsprogs e2fsck:e2fsprogs debugfs:e2fsprogs strip:binutils
 python=${PYTHON:-$ROOT/.venv/bin/python}
 "$python" -c 'import mcap' 2>/dev/null ||
   missing "the Python package mcap" "pip install -r scripts/requirements-ci.txt (.ci/run makes .venv)"
@@ -37,11 +37,9 @@ python=${PYTHON:-$ROOT/.venv/bin/python}
 # 2. Kernel and busybox.
 vm_kernel
 
-# 3. bearingd, static (musl), the build every VM test shares (common.sh). The same binary
-#    replays the logs on the host: a static binary runs there too, and a host build of
-#    `-p bearingd` alone would unify features differently from the test step's and rebuild.
+# 3. The test step's bearingd (common.sh): in the VM, and on the host to replay the logs.
 vm_binaries
-HOSTBIN=$MUSL_BIN/bearingd
+HOSTBIN=$HOST_BIN/bearingd
 
 # 4. initramfs: busybox, the block and ext4 modules, bearingd, one config per case.
 say "initramfs"
@@ -57,7 +55,7 @@ for m in virtio_ring virtio virtio_pci_modern_dev virtio_pci_legacy_dev virtio_p
   # Built into this kernel when absent (the init skips it).
   [ -n "$found" ] && cp "$found" "$IR/lib/modules/"
 done
-strip -o "$IR/bin/bearingd" "$MUSL_BIN/bearingd"
+vm_install_binary "$HOSTBIN" "$IR"
 for case in synced control; do
   case $case in synced) every=2;; control) every=3600;; esac
   "$HOSTBIN" config default |

@@ -2,7 +2,7 @@
 # bearingd as a real systemd service, end to end, in a qemu VM.
 #
 # A Debian 12 root (debootstrap minbase + systemd, cached under the work directory) gets
-# bearingd through `make install-service DESTDIR=<root> BIN=<static musl binary>`, its user through
+# bearingd through `make install-service DESTDIR=<root> BIN=<the test build's binary>`, its user through
 # systemd-sysusers, a config whose only sensor is the in-process simulated one (outer-race
 # fault from 2 s of sample time), and `systemctl enable bearingd`. The root is booted as an
 # initramfs with systemd as PID 1 (rdinit=/lib/systemd/systemd) under qemu TCG. A oneshot probe
@@ -68,13 +68,14 @@ if [ ! -x "$WORK/base/lib/systemd/systemd" ]; then
   say "debootstrap took $(( $(date +%s) - t )) s"
 fi
 
-# 4. bearingd as a static musl binary, with iceoryx2 (alerts) and SocketCAN. Stripped for the
-#    VM: the release profile keeps debug info, which would only fatten the initramfs.
+# 4. The test step's bearingd (common.sh), with iceoryx2 (alerts) and SocketCAN; the VM's
+#    root is Debian 12 as the host, so its C library is there. Stripped for the VM: the
+#    release profile keeps debug info, which would only fatten the root.
 vm_binaries
-strip -o "$WORK/bearingd" "$MUSL_BIN/bearingd"
+strip -o "$WORK/bearingd" "$HOST_BIN/bearingd"
 
 # 5. The VM's root: a fresh copy of the base, then installed as an administrator would.
-say "make install-service DESTDIR=<root> BIN=<musl binary>"
+say "make install-service DESTDIR=<root> BIN=<the test build's binary>"
 R=$WORK/root
 rm -rf "$R"
 cp -a "$WORK/base" "$R"
