@@ -64,7 +64,9 @@ vm_binaries() {
 # vm_install_binary BINARY ROOT: BINARY stripped (the release profile's line tables would only
 # fatten the initramfs) into ROOT/bin, with every shared library it links (glibc's loader, libc,
 # libm, libgcc_s, as ldd lists them) at the same path under ROOT: the busybox VMs have no C
-# library of their own, and the VM's kernel runs the host's Debian 12 userland as it is.
+# library of their own, and the VM's kernel runs the host's C library as it is. The sources
+# are the host's system libraries (root's, read through their symlinks); ROOT is the VM test's
+# own fresh work directory.
 vm_install_binary() {
   local binary=$1 root=$2 lib
   mkdir -p "$root/bin"
