@@ -391,11 +391,21 @@ pub struct WindowReady<'a> {
     pub window_spectrum: &'a [Complex32],
 }
 
-/// The two stages of a hop, in this order ([`RollingEnvelope::push_staged`]).
+/// The stages of a hop, in this order ([`RollingEnvelope::push_staged`]): the window, each
+/// band engine's envelope in turn, then the whole update.
 pub enum HopStage<'a> {
     /// The window's FFT is done; the bands are not.
     Window(&'a WindowReady<'a>),
-    /// Every band's envelope spectrum and average is done too.
+    /// One band engine's envelope spectrum and average are done (engine `engine` of
+    /// [`EnvelopeUpdate::bands`]).
+    Band {
+        engine: usize,
+        band: &'a RollingBand,
+        /// For each band asked for, in order, the index of its engine.
+        band_of: &'a [usize],
+        bin_hz: f64,
+    },
+    /// Every band's envelope spectrum and average is done.
     Bands(&'a EnvelopeUpdate<'a>),
 }
 
@@ -410,9 +420,7 @@ pub struct EnvelopeUpdate<'a> {
     pub bands: &'a [RollingBand],
     /// For each band asked for, in order, the index of its engine in `bands`.
     pub band_of: &'a [usize],
-    /// The raw samples of the newest window, oldest first, as two slices of the ring buffer.
-    pub window_samples: (&'a [f32], &'a [f32]),
-    /// The real FFT of those samples (no window function), `window / 2 + 1` bins.
+    /// The real FFT of the window (no window function), `window / 2 + 1` bins.
     pub window_spectrum: &'a [Complex32],
 }
 
@@ -429,6 +437,11 @@ impl EnvelopeUpdate<'_> {
 /// envelope spectrum of the newest window and the average of the last `averages` windows. The
 /// window's FFT is shared by the bands, and a band asked for twice (two faults whose best band
 /// is the same) is computed once.
+///
+/// The band work may be spread over the samples after the window ([`Self::spread_bands`]): the
+/// daemon's block that closes a window then does only the window's FFT and what decides on it,
+/// and each band engine's envelope follows at a fixed sample after the window's end, so a
+/// replay cut in other blocks does the same work at the same samples.
 ///
 /// All memory is allocated in [`RollingEnvelope::new`] and [`RollingEnvelope::set_bands`];
 /// [`RollingEnvelope::push`] never allocates (tested with a counting allocator).
@@ -451,6 +464,20 @@ pub struct RollingEnvelope {
     band_of: Vec<usize>,
     history_used: usize,
     history_next: usize,
+    /// Samples between two band engines' envelopes after a window; 0: all at the window.
+    band_step: usize,
+    /// The newest window's band work not done yet.
+    pending: Option<PendingBands>,
+}
+
+/// What is left of a window's band work: the engines from `next_engine` on, the next one
+/// `until_step` samples from now, each writing its spectrum to history slot `slot`.
+#[derive(Clone, Copy)]
+struct PendingBands {
+    next_engine: usize,
+    until_step: usize,
+    slot: usize,
+    end_sample: u64,
 }
 
 impl RollingEnvelope {
@@ -478,6 +505,8 @@ impl RollingEnvelope {
             band_of: Vec::new(),
             history_used: 0,
             history_next: 0,
+            band_step: 0,
+            pending: None,
         };
         rolling.set_bands(bands);
         rolling
@@ -490,6 +519,20 @@ impl RollingEnvelope {
         self.phase = phase.min(self.hop - 1);
         self.until_update = self.ring.len() + self.phase;
         self
+    }
+
+    /// Spreads each window's band work over the hop: the window's stage at its end, then one
+    /// band engine every `hop / 5` samples (at most four engines, so all are done within the
+    /// hop), the whole update with the last. A caller that changes the bands, the time base
+    /// or what the update is read with first finishes the band work ([`Self::finish_bands`]).
+    pub fn spread_bands(mut self) -> Self {
+        self.band_step = (self.hop / 5).max(1);
+        self
+    }
+
+    /// Whether a window's band work is still to be done.
+    pub fn bands_pending(&self) -> bool {
+        self.pending.is_some()
     }
 
     pub fn bands(&self) -> &[RollingBand] {
@@ -513,8 +556,11 @@ impl RollingEnvelope {
     }
 
     /// Switches to other bands (allocates; meant for the periodic band re-selection, not per
-    /// hop). The averages restart, since spectra of different bands do not mix.
+    /// hop). The averages restart, since spectra of different bands do not mix. A window's
+    /// band work still to be done is dropped: finish it first ([`Self::finish_bands`]).
     pub fn set_bands(&mut self, bands: &[Band]) {
+        debug_assert!(self.pending.is_none(), "a window's band work was dropped");
+        self.pending = None;
         let (bins, averages, window) = (self.spectrum_bins, self.averages, self.ring.len());
         let mut plans = FftPlans::shared();
         self.bands.clear();
@@ -540,7 +586,10 @@ impl RollingEnvelope {
 
     /// Forgets the buffered samples (after a gap in the signal: a window must never straddle
     /// a gap) and restarts the averages. `next_sample` is the sample index of the next sample.
+    /// A window's band work still to be done is dropped: finish it first.
     pub fn restart_at(&mut self, next_sample: u64) {
+        debug_assert!(self.pending.is_none(), "a window's band work was dropped");
+        self.pending = None;
         self.write_at = 0;
         self.until_update = self.ring.len() + self.phase;
         self.samples_seen = next_sample;
@@ -557,24 +606,43 @@ impl RollingEnvelope {
         });
     }
 
-    /// Feeds samples; calls `on_hop` twice per completed hop: with the window once its FFT is
-    /// done, then with the update once the bands are done.
+    /// Feeds samples; calls `on_hop` with each stage of each completed hop ([`HopStage`]): the
+    /// window once its FFT is done, each band engine's envelope, then the whole update. With
+    /// [`Self::spread_bands`] the band stages come at their samples after the window's end (in
+    /// this call or a later one); without it, at once.
     pub fn push_staged(&mut self, mut samples: &[f32], mut on_hop: impl FnMut(HopStage)) {
         let window = self.ring.len();
         while !samples.is_empty() {
-            let take = samples
+            let mut take = samples
                 .len()
                 .min(self.until_update)
                 .min(window - self.write_at);
+            if let Some(pending) = &self.pending {
+                take = take.min(pending.until_step);
+            }
             self.ring[self.write_at..self.write_at + take].copy_from_slice(&samples[..take]);
             samples = &samples[take..];
             self.write_at = (self.write_at + take) % window;
             self.until_update -= take;
             self.samples_seen += take as u64;
+            if let Some(pending) = &mut self.pending {
+                pending.until_step -= take;
+                if pending.until_step == 0 {
+                    self.band_stage(&mut on_hop);
+                }
+            }
             if self.until_update == 0 {
                 self.until_update = self.hop;
+                self.finish_bands(&mut on_hop);
                 self.update(&mut on_hop);
             }
+        }
+    }
+
+    /// Does the band work of the newest window still to be done, at once.
+    pub fn finish_bands(&mut self, mut on_hop: impl FnMut(HopStage)) {
+        while self.pending.is_some() {
+            self.band_stage(&mut on_hop);
         }
     }
 
@@ -586,37 +654,72 @@ impl RollingEnvelope {
             window_samples: (older, newer),
             window_spectrum: self.transform.spectrum(),
         }));
-        let spectrum = self.transform.spectrum();
         let slot = self.history_next;
         self.history_next = (self.history_next + 1) % self.averages;
         self.history_used = (self.history_used + 1).min(self.averages);
-        for band in &mut self.bands {
-            band.envelope.process(spectrum, &mut band.latest);
-            let bins = band.latest.len();
-            band.history[slot * bins..(slot + 1) * bins].copy_from_slice(&band.latest);
-            // Recomputed from the history each hop (not a running sum) so that rounding never
-            // drifts over months of operation.
-            band.averaged.fill(0.0);
-            for past in band.history.chunks_exact(bins).take(self.history_used) {
-                for (a, p) in band.averaged.iter_mut().zip(past) {
-                    *a += p;
-                }
-            }
-            let scale = 1.0 / self.history_used as f32;
-            for a in &mut band.averaged {
-                *a = (*a * scale).sqrt();
-            }
-        }
-        let (newer, older) = self.ring.split_at(self.write_at);
-        on_hop(HopStage::Bands(&EnvelopeUpdate {
+        self.pending = Some(PendingBands {
+            next_engine: 0,
+            until_step: self.band_step,
+            slot,
             end_sample: self.samples_seen,
-            bin_hz: self.fs_hz / self.ring.len() as f64,
+        });
+        if self.band_step == 0 {
+            self.finish_bands(on_hop);
+        }
+    }
+
+    /// The next step of the newest window's band work: one engine's envelope and average,
+    /// and after the last engine (or at once if there is none), the whole update.
+    fn band_stage(&mut self, on_hop: &mut impl FnMut(HopStage)) {
+        let Some(mut pending) = self.pending.take() else {
+            return;
+        };
+        let bin_hz = self.fs_hz / self.ring.len() as f64;
+        if let Some(band) = self.bands.get_mut(pending.next_engine) {
+            band.process(self.transform.spectrum(), pending.slot, self.history_used);
+            on_hop(HopStage::Band {
+                engine: pending.next_engine,
+                band,
+                band_of: &self.band_of,
+                bin_hz,
+            });
+            pending.next_engine += 1;
+        }
+        if pending.next_engine < self.bands.len() {
+            pending.until_step = self.band_step;
+            self.pending = Some(pending);
+            return;
+        }
+        on_hop(HopStage::Bands(&EnvelopeUpdate {
+            end_sample: pending.end_sample,
+            bin_hz,
             windows_averaged: self.history_used,
             bands: &self.bands,
             band_of: &self.band_of,
-            window_samples: (older, newer),
             window_spectrum: self.transform.spectrum(),
         }));
+    }
+}
+
+impl RollingBand {
+    /// The envelope spectrum of a window into history slot `slot`, and the average of the
+    /// `used` newest slots.
+    fn process(&mut self, window_spectrum: &[Complex32], slot: usize, used: usize) {
+        self.envelope.process(window_spectrum, &mut self.latest);
+        let bins = self.latest.len();
+        self.history[slot * bins..(slot + 1) * bins].copy_from_slice(&self.latest);
+        // Recomputed from the history each hop (not a running sum) so that rounding never
+        // drifts over months of operation.
+        self.averaged.fill(0.0);
+        for past in self.history.chunks_exact(bins).take(used) {
+            for (a, p) in self.averaged.iter_mut().zip(past) {
+                *a += p;
+            }
+        }
+        let scale = 1.0 / used as f32;
+        for a in &mut self.averaged {
+            *a = (*a * scale).sqrt();
+        }
     }
 }
 

@@ -1,8 +1,8 @@
-//! The squared-envelope spectrum against a naive-DFT oracle, and the rolling form against the
-//! batch form.
+//! The squared-envelope spectrum against a naive-DFT oracle, the rolling form against the
+//! batch form, and the rolling form's band work spread over the hop against it done at once.
 
 use bearingd::analysis::envelope::{
-    welch_envelope_spectrum, BandEnvelope, FftPlans, RollingEnvelope, WindowTransform,
+    welch_envelope_spectrum, BandEnvelope, FftPlans, HopStage, RollingEnvelope, WindowTransform,
 };
 use bearingd::analysis::Band;
 use bearingd::random::Rng;
@@ -155,5 +155,108 @@ fn rolling_average_equals_batch_welch_whatever_the_block_sizes() {
             (r - b).abs() <= 1e-4 * peak,
             "bin {k}: rolling {r} vs batch {b}"
         );
+    }
+}
+
+/// What a rolling envelope hands out, stage by stage: the window's end and, for a band stage,
+/// the engine and its average; for the whole update, every engine's average.
+#[derive(Debug, PartialEq)]
+enum Seen {
+    Window(u64),
+    Band(usize, Vec<f32>),
+    Update(u64, usize, Vec<Vec<f32>>),
+}
+
+fn seen(stage: HopStage) -> Seen {
+    match stage {
+        HopStage::Window(ready) => Seen::Window(ready.end_sample),
+        HopStage::Band { engine, band, .. } => {
+            Seen::Band(engine, band.averaged_amplitude().to_vec())
+        }
+        HopStage::Bands(update) => Seen::Update(
+            update.end_sample,
+            update.windows_averaged,
+            update
+                .bands
+                .iter()
+                .map(|b| b.averaged_amplitude().to_vec())
+                .collect(),
+        ),
+    }
+}
+
+#[test]
+fn spread_band_work_is_the_same_work_at_fixed_samples_whatever_the_blocks() {
+    let (fs, window, hop, bins) = (12_000.0, 4096, 2048, 400);
+    // Three bands asked for, one of them twice: three engines.
+    let bands = [
+        Band::new(2_000.0, 4_000.0),
+        Band::new(1_000.0, 2_500.0),
+        Band::new(2_000.0, 4_000.0),
+        Band::new(3_500.0, 5_500.0),
+    ];
+    // The last window ends at 39,212 (300 + 4096 + 17 hops), its bands due after 39,500.
+    let x = am_signal(39_500, fs, 3_000.0, 105.0, 0.5, 11);
+    let make = || RollingEnvelope::new(fs, window, hop, 4, &bands, bins).with_phase(300);
+    let mut at_once = Vec::new();
+    make().push_staged(&x, |stage| at_once.push(seen(stage)));
+    assert_eq!(
+        at_once.len(),
+        18 * 5,
+        "18 windows of a window, 3 bands and an update"
+    );
+
+    let step = (hop / 5) as u64;
+    let mut rng = Rng::new(3);
+    for largest in [1, 700, 5_000] {
+        let mut spread = make().spread_bands();
+        let (mut rest, mut pushed) = (&x[..], 0u64);
+        let mut stages: Vec<(Seen, u64, u64)> = Vec::new();
+        while !rest.is_empty() {
+            let take = ((rng.uniform() * largest as f64) as usize + 1).min(rest.len());
+            let from = pushed;
+            pushed += take as u64;
+            spread.push_staged(&rest[..take], |stage| {
+                stages.push((seen(stage), from, pushed))
+            });
+            rest = &rest[take..];
+        }
+        assert!(
+            spread.bands_pending(),
+            "the last window's bands wait for their samples"
+        );
+        spread.finish_bands(|stage| stages.push((seen(stage), pushed, pushed)));
+        assert!(!spread.bands_pending());
+        let values: Vec<&Seen> = stages.iter().map(|s| &s.0).collect();
+        assert_eq!(
+            values,
+            at_once.iter().collect::<Vec<_>>(),
+            "blocks up to {largest}"
+        );
+        // Each band stage comes in the block holding its sample: engine k at the window's end
+        // plus (k + 1) steps, the update with the last engine; the last window's at the end.
+        let mut window_end = 0;
+        for (stage, from, to) in &stages {
+            let due = match stage {
+                Seen::Window(end) => {
+                    window_end = *end;
+                    *end
+                }
+                Seen::Band(engine, _) => window_end + (*engine as u64 + 1) * step,
+                Seen::Update(..) => window_end + 3 * step,
+            };
+            if due > pushed {
+                assert_eq!(
+                    (*from, *to),
+                    (pushed, pushed),
+                    "{stage:?} finished at the end"
+                );
+            } else {
+                assert!(
+                    *from < due && due <= *to,
+                    "{stage:?} due at {due}, in [{from}, {to}]"
+                );
+            }
+        }
     }
 }

@@ -19,7 +19,12 @@
 //!   false-alarm rate (a verdict on 3 s of a CWRU ball record named the inner race that 10 s
 //!   do not). Until the first selection the channel is learning and raises no flag.
 //! - Scores: every hop, each fault's score in its own band's rolling (averaged) envelope
-//!   spectrum, for the log, the status and the twin: what the spectrum shows now.
+//!   spectrum, for the log, the status and the twin: what the spectrum shows now. They decide
+//!   nothing, so they do not hold up what does: the block that closes a window runs the
+//!   window's FFT and what decides on it (detectors, indicators, health, trend); each band's
+//!   envelope and scores follow a fifth of a hop apart in the next blocks
+//!   ([`RollingEnvelope::spread_bands`]), the window's report with the last. Anything the
+//!   report depends on (bands, speed, a gap, the signal's end) first finishes it.
 //! - Health: the stage tracker, fed with each window's kurtosis and RMS, and the RMS trend
 //!   (one point per `trend.point_s`, fitted against the failure limit once degrading).
 //! - Sensor: clipping (counts at full scale) and a flat line (no change for a second) are
@@ -66,7 +71,7 @@ use super::envelope::{window_samples, HopStage, RollingEnvelope};
 use super::fault_bands::{FaultScore, FaultScorer};
 use super::flags::FaultFlag;
 use super::health::{Baseline, HealthTracker, CONFIRM_WINDOWS};
-use super::indicators::WindowIndicators;
+use super::indicators::{Indicators, WindowIndicators};
 use super::speed::SpeedMode;
 use super::Band;
 use crate::bearing::FaultFrequencies;
@@ -129,6 +134,74 @@ pub struct ChannelMonitor {
     ending: bool,
     /// The detectors run besides the fault scores ([`MonitorSettings::detectors`]).
     detectors: Vec<Box<dyn ChannelDetector>>,
+    /// The newest window's indicators, for its report once its bands are done.
+    window_indicators: Indicators,
+}
+
+/// A window's fault scores and report, built from its band stages as they come
+/// ([`HopStage::Band`], then [`HopStage::Bands`]).
+struct ReportScoring<'m> {
+    scorer: &'m mut FaultScorer,
+    scores: &'m mut [FaultScore; 4],
+    bands: &'m [Band; 4],
+    freqs: &'m FaultFrequencies,
+    speed_known: bool,
+    indicators: &'m mut Indicators,
+}
+
+impl ReportScoring<'_> {
+    /// Each band's spectrum is prepared once, in the scorer slot of its engine, then scored
+    /// for the faults whose band it is. Before the first band selection there are no band
+    /// engines: every fault is scored on nothing (as without a speed to score against).
+    fn on_band_stage(&mut self, stage: HopStage, on_event: &mut impl FnMut(MonitorEvent)) {
+        match stage {
+            HopStage::Window(_) => {}
+            HopStage::Band {
+                engine,
+                band,
+                band_of,
+                bin_hz,
+            } => {
+                let spectrum = if self.speed_known {
+                    band.averaged_amplitude()
+                } else {
+                    &[]
+                };
+                self.scorer.prepare(engine, spectrum, bin_hz, self.freqs);
+                // The faults whose band this engine computes (a band asked for twice is one
+                // engine); `engine` is at most the first such fault's index.
+                for (i, kind) in FaultKind::ALL.iter().enumerate() {
+                    if band_of.get(i) == Some(&engine) {
+                        self.scores[i] = self
+                            .scorer
+                            .score_prepared(engine, spectrum, *kind, self.freqs);
+                    }
+                }
+            }
+            HopStage::Bands(update) => {
+                if update.bands.is_empty() {
+                    for (i, kind) in FaultKind::ALL.iter().enumerate() {
+                        self.scorer.prepare(i, &[], update.bin_hz, self.freqs);
+                        self.scores[i] = self.scorer.score_prepared(i, &[], *kind, self.freqs);
+                    }
+                }
+                let scores = &*self.scores;
+                let top = (0..4)
+                    .max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))
+                    .unwrap_or(0);
+                on_event(MonitorEvent::Window(WindowReport {
+                    end_sample: update.end_sample,
+                    indicators: *self.indicators,
+                    scores,
+                    bands: self.bands,
+                    spectrum: update.band(top).map_or(&[][..], |b| b.averaged_amplitude()),
+                    spectrum_band: update.band(top).map_or(self.bands[top], |b| b.band()),
+                    bin_hz: update.bin_hz,
+                    windows_averaged: update.windows_averaged,
+                }));
+            }
+        }
+    }
 }
 
 /// Samples converted per chunk (the scratch buffer's size).
@@ -185,7 +258,8 @@ impl ChannelMonitor {
                 &[],
                 bins,
             )
-            .with_phase(share_of(hop, settings.window_stagger)),
+            .with_phase(share_of(hop, settings.window_stagger))
+            .spread_bands(),
             scorer,
             flags: std::array::from_fn(|_| FaultFlag::new(settings.flags)),
             health: HealthTracker::new(
@@ -229,6 +303,7 @@ impl ChannelMonitor {
             orders,
             speed_known,
             pending_speed: None,
+            window_indicators: Indicators::default(),
             settings,
         }
     }
@@ -297,6 +372,7 @@ impl ChannelMonitor {
         estimated: bool,
         on_event: &mut impl FnMut(MonitorEvent),
     ) {
+        self.finish_window(on_event);
         let max = self.settings.speed.max_shaft_hz(self.freqs.shaft);
         let usable = usable_shaft_hz(given, max);
         let was_known = self.speed_known;
@@ -379,6 +455,7 @@ impl ChannelMonitor {
         on_event: &mut impl FnMut(MonitorEvent),
     ) {
         if first_sample != self.next_sample {
+            self.finish_window(on_event);
             // A selection under way is used before the jump (a restart may go back).
             if self.band_result_at.is_some() {
                 self.use_band_result(on_event);
@@ -487,6 +564,20 @@ impl ChannelMonitor {
             detector.on_samples(samples, &mut |m| on_event(MonitorEvent::Detector(m)));
         }
 
+        self.run_hops(Some(samples), on_event);
+    }
+
+    /// Does the newest window's band work still to be done (its scores and report), before
+    /// anything its report depends on changes: the bands, the speed, the time base.
+    fn finish_window(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
+        if self.rolling.bands_pending() {
+            self.run_hops(None, on_event);
+        }
+    }
+
+    /// Feeds `samples` (in g) to the rolling envelope, or with `None` finishes the newest
+    /// window's band work, and handles the hop stages that come out.
+    fn run_hops(&mut self, samples: Option<&[f32]>, on_event: &mut impl FnMut(MonitorEvent)) {
         let ChannelMonitor {
             rolling,
             indicators,
@@ -498,19 +589,27 @@ impl ChannelMonitor {
             bands,
             freqs,
             speed_known,
+            window_indicators,
             ..
         } = self;
-        let speed_known = *speed_known;
         // What decides on the window alone (detectors, indicators, health stage, trend) runs
-        // as soon as its FFT is done, before the bands: its flags and alerts never wait for
-        // the band envelopes and fault scores, which only feed the window's report.
-        let mut window_indicators = None;
-        rolling.push_staged(samples, |stage| match stage {
+        // as soon as its FFT is done, in the block that closes the window: its flags and
+        // alerts never wait for the band envelopes and fault scores, which only feed the
+        // window's report and follow in the next blocks ([`RollingEnvelope::spread_bands`]).
+        let mut report = ReportScoring {
+            scorer,
+            scores,
+            bands,
+            freqs,
+            speed_known: *speed_known,
+            indicators: window_indicators,
+        };
+        let mut on_hop = |stage: HopStage<'_>| match stage {
             HopStage::Window(ready) => {
                 let window = WindowView {
                     end_sample: ready.end_sample,
                     spectrum: ready.window_spectrum,
-                    shaft_hz: speed_known.then_some(freqs.shaft),
+                    shaft_hz: report.speed_known.then_some(report.freqs.shaft),
                 };
                 for detector in detectors.iter_mut() {
                     detector.on_window(&window, &mut |m| on_event(MonitorEvent::Detector(m)));
@@ -528,42 +627,14 @@ impl ChannelMonitor {
                 if let Some(point) = trend.push(indicators.rms, ready.end_sample, threshold) {
                     on_event(MonitorEvent::Trend { point, stage });
                 }
-                window_indicators = Some(indicators);
+                *report.indicators = indicators;
             }
-            HopStage::Bands(update) => {
-                // Before the first band selection there are no band engines: nothing to score;
-                // nor without a speed to score against. Each band's spectrum is prepared once,
-                // in the scorer slot of its engine (at most the fault's index; faults whose best
-                // band is the same share it), then scored for its faults.
-                let slot = |i: usize| update.band_of.get(i).copied().unwrap_or(i);
-                let mut prepared = [false; FaultKind::ALL.len()];
-                for (i, kind) in FaultKind::ALL.iter().enumerate() {
-                    let spectrum = update
-                        .band(i)
-                        .filter(|_| speed_known)
-                        .map_or(&[][..], |b| b.averaged_amplitude());
-                    if !std::mem::replace(&mut prepared[slot(i)], true) {
-                        scorer.prepare(slot(i), spectrum, update.bin_hz, freqs);
-                    }
-                    scores[i] = scorer.score_prepared(slot(i), spectrum, *kind, freqs);
-                }
-                let top = (0..4)
-                    .max_by(|&a, &b| scores[a].score.total_cmp(&scores[b].score))
-                    .unwrap_or(0);
-                // The window stage came first in this hop; its indicators are this window's.
-                let indicators = window_indicators.take().unwrap_or_default();
-                on_event(MonitorEvent::Window(WindowReport {
-                    end_sample: update.end_sample,
-                    indicators,
-                    scores,
-                    bands,
-                    spectrum: update.band(top).map_or(&[][..], |b| b.averaged_amplitude()),
-                    spectrum_band: update.band(top).map_or(bands[top], |b| b.band()),
-                    bin_hz: update.bin_hz,
-                    windows_averaged: update.windows_averaged,
-                }));
-            }
-        });
+            stage => report.on_band_stage(stage, on_event),
+        };
+        match samples {
+            Some(samples) => rolling.push_staged(samples, &mut on_hop),
+            None => rolling.finish_bands(&mut on_hop),
+        }
     }
 
     fn history_sample(&self, index: usize) -> f32 {

@@ -49,6 +49,7 @@ impl ChannelMonitor {
     /// Takes the result of the selection under way (waiting for it if it is not done) and
     /// follows its speed estimate and its bands.
     pub(super) fn use_band_result(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
+        self.finish_window(on_event);
         self.band_result_at = None;
         let Some(BandResult {
             estimated_shaft_hz,
@@ -121,6 +122,7 @@ impl ChannelMonitor {
     /// on the verdict of everything the channel saw.
     pub fn finish(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
         self.ending = true;
+        self.finish_window(on_event);
         if self.band_result_at.is_some() {
             self.use_band_result(on_event);
         }
