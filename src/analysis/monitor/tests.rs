@@ -148,3 +148,35 @@ fn each_windows_indicators_are_those_of_its_samples() {
         assert_eq!(got.peak, want.peak, "at {end}");
     }
 }
+
+/// A window's report waits for its band stages ([`RollingEnvelope::spread_bands`]); a gap
+/// comes before them: the report still comes, with that window's end, before the gap's event
+/// and before any window after the gap.
+#[test]
+fn a_gap_finishes_the_report_of_the_window_before_it() {
+    let window = window_samples(AnalysisSettings::default().window_s, FS);
+    let mut monitor = monitor();
+    // One sample past the window's end: its report is due a fifth of a hop later.
+    let before = counts(window + 1, 7);
+    assert!(windows(&mut monitor, 0, &before).is_empty());
+    assert!(monitor.rolling.bands_pending());
+
+    let mut events = Vec::new();
+    let after = counts(3 * window, 8);
+    monitor.push_counts(10 * window as u64, &after, 0.001, &mut |event| {
+        events.push(match event {
+            MonitorEvent::Window(report) => format!("window {}", report.end_sample),
+            MonitorEvent::Gap { at_sample, .. } => format!("gap {at_sample}"),
+            _ => return,
+        })
+    });
+    assert_eq!(
+        events.get(..2),
+        Some(&[format!("window {window}"), format!("gap {}", window + 1)][..]),
+        "{events:?}"
+    );
+    assert!(
+        events[2..].iter().all(|e| e.starts_with("window ")) && events.len() > 2,
+        "windows after the gap: {events:?}"
+    );
+}
