@@ -180,3 +180,32 @@ fn a_gap_finishes_the_report_of_the_window_before_it() {
         "windows after the gap: {events:?}"
     );
 }
+
+/// A speed change while a window's band stages wait: the window's report comes first, scored
+/// with the fault frequencies the window was taken at, then the speed's event.
+#[test]
+fn a_speed_change_finishes_the_report_of_the_window_before_it() {
+    let window = window_samples(AnalysisSettings::default().window_s, FS);
+    let mut monitor = monitor();
+    let shaft = monitor.freqs.shaft;
+    monitor.settings.speed = SpeedMode::Given {
+        known_at_start: true,
+        max_shaft_hz: 2.0 * shaft,
+    };
+    assert!(windows(&mut monitor, 0, &counts(window + 1, 9)).is_empty());
+    assert!(monitor.rolling.bands_pending());
+
+    let mut events = Vec::new();
+    monitor.set_speed_at(window as u64 + 1, Some(1.5 * shaft), &mut |event| {
+        events.push(match event {
+            MonitorEvent::Window(report) => format!("window {}", report.end_sample),
+            MonitorEvent::Speed { at_sample, .. } => format!("speed {at_sample}"),
+            _ => return,
+        })
+    });
+    assert_eq!(
+        events,
+        [format!("window {window}"), format!("speed {}", window + 1)],
+    );
+    assert!(!monitor.rolling.bands_pending());
+}
