@@ -73,7 +73,7 @@ timed_by_wall_clock=(
 skips=()
 for name in "${slow_under_qemu[@]}" "${timed_by_wall_clock[@]}"; do skips+=(--skip "$name"); done
 cargo test --release --locked --target "$target" \
-  -p bearing-wire -p bearing-signal -p bearing-iox -p bearingd --lib -- --exact "${skips[@]}"
+  -p bearing-wire -p bearing-signal -p bearing-core -p bearing-iox -p bearingd --lib -- --exact "${skips[@]}"
 
 cargo build --release --locked --target "$target" -p bearingd --bin bearingd
 binary="target/$target/release/bearingd"

@@ -27,22 +27,26 @@
 //! - [`learned`]: the learned diagnosis (seed 001): a denoising autoencoder + 1-D CNN trained
 //!   only on synthetic records (`bearingd train`, in the lab crate `bearingd-lab`), run here by a
 //!   plain forward pass; an extra opinion that the envelope evidence must back
-//!   (`analyze --learned`, `twin.learned_model`).
+//!   (`analyze --learned`, `twin.learned_model`). From the `bearing-core` crate, like [`twin`],
+//!   [`analysis`] and [`messages`].
 //! - [`iox`]: iceoryx2 service names, the file prefix and the root, in one place (the
 //!   `bearing-iox` crate, shared with the publishers).
 //! - [`twin`]: the twins of a defective bearing: the signal model (simulation and online fits)
 //!   and the Hammerstein–Wiener identification (`twin::hw`). The 6-DOF physics model, its
 //!   calibration and the labelled synthetic data sets are the lab's (`bearingd_lab::twin`).
+//!   From `bearing-core`.
 //! - [`analysis`]: the sans-IO diagnosis core. Samples in, results out; it owns its buffers and
 //!   knows no clock, no file, no async runtime, so `run`, `replay` and `analyze` share it and
-//!   cannot disagree.
+//!   cannot disagree. It is the `bearing-core` crate's (with [`messages`], [`twin`] and
+//!   [`learned`]), built for speed where the service is built for size.
 //! - [`recording`]: readers for recorded data (CWRU `.mat`, PRONOSTIA and plain CSV, IMS text,
 //!   WAV) that turn a file into samples plus what the file says about itself.
 //! - [`mcap_log`]: the MCAP log's format: topics, schemas, file names, the bounded scanner and
 //!   the reader (the writer is a sink, the replay a source).
 //! - [`messages`]: the vocabulary every room above speaks: typed faults, flags, health stages,
 //!   speed sources and the pipeline's messages, with the one list of detectors whose messages
-//!   the pipeline carries ([`messages::detect`]); MCAP and iceoryx2 encode them at the edge.
+//!   the pipeline carries ([`messages::detect`]); MCAP and iceoryx2 encode them at the edge
+//!   (from `bearing-core`).
 //! - [`bearing`]: bearing geometry, the catalog of named bearings, fault frequencies and the
 //!   fault kinds (from the `bearing-signal` crate, shared with `firmware-sim`).
 //! - [`machine_fault`]: the machine faults beside the bearing (unbalance, misalignment,
@@ -56,7 +60,7 @@
 //!
 //! Data flow and the reasons behind it: `docs/ARCHITECTURE.md`.
 
-pub mod analysis;
+pub use bearing_core::analysis;
 pub use bearing_signal::bearing;
 pub mod cli;
 pub mod clock;
@@ -64,10 +68,10 @@ pub mod config;
 pub mod daemon;
 pub mod fsafe;
 pub mod iox;
-pub mod learned;
+pub use bearing_core::learned;
 pub use bearing_signal::machine_fault;
 pub mod mcap_log;
-pub mod messages;
+pub use bearing_core::messages;
 pub mod offline;
 pub mod pipeline;
 pub use bearing_signal::random;
@@ -75,4 +79,4 @@ pub mod recording;
 pub mod report;
 pub mod sinks;
 pub mod sources;
-pub mod twin;
+pub use bearing_core::twin;

@@ -7,14 +7,14 @@
 //! the loss also shows as exact gaps), `Block` for tests and replay, where the producer waits
 //! and pushes back into the transport instead.
 //!
-//! Storage: crossbeam's lock-free `ArrayQueue` (fixed capacity, allocated once); its
-//! `force_push` hands back the oldest item, which `DropOldest` counts. A producer that must
-//! `Block` waits on a `Condvar` that the consumer signals after each pop; a tokio `Notify` wakes
-//! the async consumer.
+//! Storage: a `VecDeque` of fixed capacity (allocated once, never grown) under a mutex, held
+//! for a push or a pop only; an item is a whole transport batch, so the lock is taken per
+//! batch, never per sample. A producer that must `Block` waits on a `Condvar`
+//! of that mutex, signalled after each pop; a tokio `Notify` wakes the async consumer.
 
-use crossbeam_queue::ArrayQueue;
+use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::{Arc, Condvar, Mutex};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 use tokio::sync::Notify;
 
@@ -29,23 +29,29 @@ pub enum WhenFull {
 
 #[derive(Debug)]
 struct Shared<T> {
-    items: ArrayQueue<T>,
+    items: Mutex<VecDeque<T>>,
+    capacity: usize,
     /// Items dropped since the consumer last looked.
     dropped: AtomicU64,
     /// Either end is gone.
     closed: AtomicBool,
-    /// A blocked producer waits here for room (the mutex guards nothing but the wait).
-    room_lock: Mutex<()>,
+    /// A blocked producer waits here (on `items`) for room.
     room: Condvar,
     ready: Notify,
     when_full: WhenFull,
 }
 
 impl<T> Shared<T> {
+    /// The items, locked. A panic while the lock was held cannot have left a `VecDeque`
+    /// half-changed, so a poisoned lock is used as it is.
+    fn items(&self) -> MutexGuard<'_, VecDeque<T>> {
+        self.items.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
     fn close(&self) {
         self.closed.store(true, Ordering::Release);
         // Taking the lock orders this with a producer between its check and its wait.
-        drop(self.room_lock.lock());
+        drop(self.items());
         self.room.notify_all();
         self.ready.notify_one();
     }
@@ -65,11 +71,12 @@ pub struct Consumer<T> {
 
 /// A queue of at most `capacity` (≥ 1) items.
 pub fn bounded<T>(capacity: usize, when_full: WhenFull) -> (Producer<T>, Consumer<T>) {
+    let capacity = capacity.max(1);
     let shared = Arc::new(Shared {
-        items: ArrayQueue::new(capacity.max(1)),
+        items: Mutex::new(VecDeque::with_capacity(capacity)),
+        capacity,
         dropped: AtomicU64::new(0),
         closed: AtomicBool::new(false),
-        room_lock: Mutex::new(()),
         room: Condvar::new(),
         ready: Notify::new(),
         when_full,
@@ -89,45 +96,38 @@ impl<T> Producer<T> {
         if shared.closed.load(Ordering::Acquire) {
             return false;
         }
-        match shared.when_full {
-            WhenFull::DropOldest => {
-                if shared.items.force_push(item).is_some() {
+        let mut items = shared.items();
+        if items.len() >= shared.capacity {
+            match shared.when_full {
+                WhenFull::DropOldest => {
+                    items.pop_front();
                     shared.dropped.fetch_add(1, Ordering::Relaxed);
                 }
-            }
-            WhenFull::Block => {
-                let mut item = item;
-                while let Err(back) = shared.items.push(item) {
-                    item = back;
-                    let Ok(guard) = shared.room_lock.lock() else {
-                        return false;
-                    };
-                    if shared.closed.load(Ordering::Acquire) {
-                        return false;
-                    }
-                    if shared.items.is_full() {
-                        // The consumer signals under the lock after a pop; the timeout is only
-                        // a second guard.
-                        if shared
-                            .room
-                            .wait_timeout(guard, Duration::from_millis(50))
-                            .is_err()
-                        {
+                WhenFull::Block => {
+                    while items.len() >= shared.capacity {
+                        if shared.closed.load(Ordering::Acquire) {
                             return false;
                         }
+                        // The consumer signals after each pop; the timeout is only a second
+                        // guard.
+                        items = shared
+                            .room
+                            .wait_timeout(items, Duration::from_millis(50))
+                            .unwrap_or_else(PoisonError::into_inner)
+                            .0;
                     }
                 }
             }
         }
+        items.push_back(item);
+        drop(items);
         shared.ready.notify_one();
         true
     }
-}
 
-impl<T> Producer<T> {
     /// Whether a push now would find the queue full.
     pub fn is_full(&self) -> bool {
-        self.shared.items.is_full()
+        self.shared.items().len() >= self.shared.capacity
     }
 }
 
@@ -148,10 +148,10 @@ impl<T> Consumer<T> {
             let notified = shared.ready.notified();
             // Read `closed` before popping: an item pushed before the close is still taken.
             let closed = shared.closed.load(Ordering::Acquire);
-            if let Some(item) = shared.items.pop() {
+            let popped = shared.items().pop_front();
+            if let Some(item) = popped {
                 let dropped = shared.dropped.swap(0, Ordering::Relaxed);
                 if shared.when_full == WhenFull::Block {
-                    drop(shared.room_lock.lock());
                     shared.room.notify_one();
                 }
                 return Some((item, dropped));

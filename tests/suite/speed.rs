@@ -1,5 +1,5 @@
-//! The shaft speed estimated from the vibration (src/analysis/speed.rs) on real and simulated
-//! records: from a nominal speed 3 % off, the estimate lands within 0.5 % of the measured speed,
+//! The shaft speed estimated from the vibration (crates/bearing-core/src/analysis/speed.rs) on
+//! real and simulated records: from a nominal speed 3 % off, the estimate lands within 0.5 % of the measured speed,
 //! and the diagnosis with the estimated speed is the diagnosis with the measured one.
 
 use bearingd::analysis::envelope::FftPlans;
