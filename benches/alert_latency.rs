@@ -16,7 +16,10 @@
 //! It also prints the machine's own jitter first ([`common::host_jitter_ms`]: a fixed 0.3 ms of
 //! arithmetic after a 2 ms sleep, 5,000 times), the floor under any tail measured here: on a
 //! virtual machine whose host takes the CPU away now and then, that alone has a p99 several
-//! times its median, and an alert's p99 cannot be read without it.
+//! times its median, and an alert's p99 cannot be read without it. And the machine's wake-up
+//! ([`common::wake_up_ms`]: another process asleep for 50 ms woken through a socket, 400 times,
+//! before the daemon starts): every alert wakes the subscriber, so that latency is in every alert's,
+//! whatever the daemon does.
 //!
 //! `BENCH_WINDOWS=N` (issue 12, "p99 < 1 ms over 10,000 windows"): one round instead, long
 //! enough for N analysis windows over all sensors, every sensor faulty from the start and the
@@ -38,7 +41,7 @@ use bearingd::clock::wall_clock_now_ns;
 use bearingd::iox::IoxSettings;
 use bearingd::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
 use common::{
-    env_or, host_jitter_ms, percentile, simulated_sensors, CHATTERING_IMBALANCE_G,
+    env_or, host_jitter_ms, percentile, simulated_sensors, wake_up_ms, CHATTERING_IMBALANCE_G,
     CHATTERING_THRESHOLDS, DEFAULT_IMBALANCE_G,
 };
 use std::fmt::Write as _;
@@ -91,6 +94,9 @@ fn main() {
     if std::env::args().any(|a| a == "--list") {
         return; // `cargo test --benches` asks for a list; nothing to run quickly here
     }
+    if common::run_wake_receiver() {
+        return;
+    }
     let sensors = env_or("BENCH_SENSORS", 16);
     let rate = env_or("BENCH_RATE", 25_600);
     let windows = env_or("BENCH_WINDOWS", 0);
@@ -119,6 +125,16 @@ fn main() {
         percentile(&jitter, 50.0),
         percentile(&jitter, 99.0),
         percentile(&jitter, 99.9)
+    );
+    // The other floor: how long this machine takes to wake a thread asleep in the kernel, as
+    // the subscriber is between alerts.
+    let wake = wake_up_ms(50, 400);
+    let wake = format!(
+        "wake-up, another process asleep on a Unix datagram socket for 50 ms, woken 400 times: \
+         p50 {:.3} ms, p99 {:.3} ms, p999 {:.3} ms",
+        percentile(&wake, 50.0),
+        percentile(&wake, 99.0),
+        percentile(&wake, 99.9)
     );
     let daemon_path = std::env::var("BENCH_BEARINGD")
         .unwrap_or_else(|_| env!("CARGO_BIN_EXE_bearingd").to_string());
@@ -207,4 +223,5 @@ fn main() {
         latencies_ms[0]
     );
     println!("{host}");
+    println!("{wake}");
 }

@@ -93,3 +93,81 @@ pub fn host_jitter_ms(work_us: f64, rounds: usize) -> Vec<f64> {
     durations.sort_by(f64::total_cmp);
     durations
 }
+
+/// The machine's own wake-up latency, the other floor under an alert's latency: the subscriber
+/// sleeps in the kernel between alerts, and the publisher's notification has to wake it. Here
+/// another process (this bench started again with [`WAKE_RECEIVER`]) sleeps on a Unix datagram
+/// socket, as iceoryx2's event does on Linux, and is sent the wall-clock time `rounds` times,
+/// `idle_ms` apart; it takes its receipt time minus the sent time. Returns the latencies in ms,
+/// ascending. An idle CPU halts (on a VM the host must then reschedule the vCPU) or enters a
+/// C-state; leaving it is what this measures, and what `outputs.cpu_wakeup_latency_us` caps.
+pub fn wake_up_ms(idle_ms: u64, rounds: usize) -> Vec<f64> {
+    use std::os::unix::net::UnixDatagram;
+    use std::process::{Command, Stdio};
+    let dir = std::env::temp_dir().join(format!("bearingd-wake-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("a scratch dir for the wake-up socket");
+    let socket = dir.join("wake.sock");
+    let receiver = Command::new(std::env::current_exe().expect("this bench's path"))
+        .arg(WAKE_RECEIVER)
+        .arg(&socket)
+        .arg(rounds.to_string())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("start the wake-up receiver");
+    let sender = UnixDatagram::unbound().expect("a Unix datagram socket");
+    let started = std::time::Instant::now();
+    while !socket.exists() {
+        assert!(
+            started.elapsed() < std::time::Duration::from_secs(10),
+            "the wake-up receiver never bound {}",
+            socket.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    for _ in 0..rounds {
+        std::thread::sleep(std::time::Duration::from_millis(idle_ms));
+        let sent = bearingd::clock::wall_clock_now_ns().to_le_bytes();
+        sender
+            .send_to(&sent, &socket)
+            .expect("send to the wake-up receiver");
+    }
+    let output = receiver
+        .wait_with_output()
+        .expect("the wake-up receiver's latencies");
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut latencies: Vec<f64> = String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .filter_map(|line| line.parse::<f64>().ok())
+        .map(|ns| ns / 1e6)
+        .collect();
+    latencies.sort_by(f64::total_cmp);
+    latencies
+}
+
+/// The argument that makes a bench the receiver of [`wake_up_ms`]: `WAKE_RECEIVER socket rounds`.
+pub const WAKE_RECEIVER: &str = "--wake-receiver";
+
+/// The receiving end of [`wake_up_ms`], when this process was started with [`WAKE_RECEIVER`]:
+/// binds the socket, takes `rounds` datagrams and prints each one's latency in ns, a line each.
+/// Returns whether it was that receiver (the bench then has nothing else to do).
+pub fn run_wake_receiver() -> bool {
+    let args: Vec<String> = std::env::args().collect();
+    let Some(at) = args.iter().position(|a| a == WAKE_RECEIVER) else {
+        return false;
+    };
+    let (socket, rounds) = match (args.get(at + 1), args.get(at + 2)) {
+        (Some(socket), Some(rounds)) => (socket, rounds.parse().unwrap_or(0usize)),
+        _ => panic!("{WAKE_RECEIVER} needs a socket path and a number of rounds"),
+    };
+    let receiver = std::os::unix::net::UnixDatagram::bind(socket).expect("bind the wake-up socket");
+    let mut sent = [0u8; 8];
+    for _ in 0..rounds {
+        if receiver.recv(&mut sent).is_err() {
+            break;
+        }
+        let now = bearingd::clock::wall_clock_now_ns();
+        println!("{}", now.saturating_sub(u64::from_le_bytes(sent)));
+    }
+    true
+}
