@@ -41,8 +41,8 @@ use bearingd::clock::wall_clock_now_ns;
 use bearingd::iox::IoxSettings;
 use bearingd::sinks::alerts::service::{AlertServiceSettings, AlertSubscriber, Received};
 use common::{
-    env_or, host_jitter_ms, percentile, simulated_sensors, wake_up_ms, CHATTERING_IMBALANCE_G,
-    CHATTERING_THRESHOLDS, DEFAULT_IMBALANCE_G,
+    env_or, host_jitter_ms, percentile, simulated_sensors, spread_ms, wake_up_ms,
+    CHATTERING_IMBALANCE_G, CHATTERING_THRESHOLDS, DEFAULT_IMBALANCE_G,
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -120,21 +120,15 @@ fn main() {
     // The floor under the tail: the same machine's jitter on a fixed 0.3 ms of work.
     let jitter = host_jitter_ms(300.0, 5_000);
     let host = format!(
-        "host jitter, a fixed 0.3 ms of work after a 2 ms sleep, 5,000 times: p50 {:.2} ms, \
-         p99 {:.2} ms, p999 {:.2} ms",
-        percentile(&jitter, 50.0),
-        percentile(&jitter, 99.0),
-        percentile(&jitter, 99.9)
+        "host jitter, a fixed 0.3 ms of work after a 2 ms sleep, 5,000 times: {}",
+        spread_ms(&jitter, 2)
     );
-    // The other floor: how long this machine takes to wake a thread asleep in the kernel, as
+    // The other floor: how long this machine takes to wake a process asleep in the kernel, as
     // the subscriber is between alerts.
-    let wake = wake_up_ms(50, 400);
+    let wake_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("alert-latency-wake-up");
     let wake = format!(
-        "wake-up, another process asleep on a Unix datagram socket for 50 ms, woken 400 times: \
-         p50 {:.3} ms, p99 {:.3} ms, p999 {:.3} ms",
-        percentile(&wake, 50.0),
-        percentile(&wake, 99.0),
-        percentile(&wake, 99.9)
+        "wake-up, another process asleep on a Unix datagram socket for 50 ms, woken 400 times: {}",
+        spread_ms(&wake_up_ms(&wake_dir, 50, 400), 3)
     );
     let daemon_path = std::env::var("BENCH_BEARINGD")
         .unwrap_or_else(|_| env!("CARGO_BIN_EXE_bearingd").to_string());

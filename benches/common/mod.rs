@@ -13,6 +13,12 @@ pub fn env_or(name: &str, default: usize) -> usize {
         .unwrap_or(default)
 }
 
+/// `p50 … ms, p99 … ms, p999 … ms` of ascending `sorted` (in ms), with `decimals` decimals.
+pub fn spread_ms(sorted: &[f64], decimals: usize) -> String {
+    let [p50, p99, p999] = [50.0, 99.0, 99.9].map(|p| percentile(sorted, p));
+    format!("p50 {p50:.decimals$} ms, p99 {p99:.decimals$} ms, p999 {p999:.decimals$} ms")
+}
+
 /// The nearest-rank percentile `p` (0–100) of ascending `sorted`; NaN when empty.
 pub fn percentile(sorted: &[f64], p: f64) -> f64 {
     if sorted.is_empty() {
@@ -101,12 +107,12 @@ pub fn host_jitter_ms(work_us: f64, rounds: usize) -> Vec<f64> {
 /// `idle_ms` apart; it takes its receipt time minus the sent time. Returns the latencies in ms,
 /// ascending. An idle CPU halts (on a VM the host must then reschedule the vCPU) or enters a
 /// C-state; leaving it is what this measures, and what `outputs.cpu_wakeup_latency_us` caps.
-pub fn wake_up_ms(idle_ms: u64, rounds: usize) -> Vec<f64> {
+/// `dir` holds the socket: a directory of this bench's own (the target dir's), emptied first.
+pub fn wake_up_ms(dir: &std::path::Path, idle_ms: u64, rounds: usize) -> Vec<f64> {
     use std::os::unix::net::UnixDatagram;
     use std::process::{Command, Stdio};
-    let dir = std::env::temp_dir().join(format!("bearingd-wake-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("a scratch dir for the wake-up socket");
+    let _ = std::fs::remove_dir_all(dir);
+    std::fs::create_dir_all(dir).expect("a scratch dir for the wake-up socket");
     let socket = dir.join("wake.sock");
     let receiver = Command::new(std::env::current_exe().expect("this bench's path"))
         .arg(WAKE_RECEIVER)
@@ -135,12 +141,19 @@ pub fn wake_up_ms(idle_ms: u64, rounds: usize) -> Vec<f64> {
     let output = receiver
         .wait_with_output()
         .expect("the wake-up receiver's latencies");
-    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(dir);
     let mut latencies: Vec<f64> = String::from_utf8_lossy(&output.stdout)
         .lines()
         .filter_map(|line| line.parse::<f64>().ok())
         .map(|ns| ns / 1e6)
         .collect();
+    assert_eq!(
+        latencies.len(),
+        rounds,
+        "the wake-up receiver reported {} of {rounds} wake-ups ({})",
+        latencies.len(),
+        output.status
+    );
     latencies.sort_by(f64::total_cmp);
     latencies
 }
@@ -156,11 +169,15 @@ pub fn run_wake_receiver() -> bool {
     let Some(at) = args.iter().position(|a| a == WAKE_RECEIVER) else {
         return false;
     };
-    let (socket, rounds) = match (args.get(at + 1), args.get(at + 2)) {
-        (Some(socket), Some(rounds)) => (socket, rounds.parse().unwrap_or(0usize)),
-        _ => panic!("{WAKE_RECEIVER} needs a socket path and a number of rounds"),
+    let (socket, rounds) = match (args.get(at + 1), args.get(at + 2).map(|r| r.parse())) {
+        (Some(socket), Some(Ok(rounds))) => (socket, rounds),
+        _ => panic!("{WAKE_RECEIVER} needs a socket path and a whole number of rounds"),
     };
     let receiver = std::os::unix::net::UnixDatagram::bind(socket).expect("bind the wake-up socket");
+    // Ends, rather than waiting forever, if the sending bench has gone.
+    receiver
+        .set_read_timeout(Some(std::time::Duration::from_secs(10)))
+        .expect("a read timeout on the wake-up socket");
     let mut sent = [0u8; 8];
     for _ in 0..rounds {
         if receiver.recv(&mut sent).is_err() {
