@@ -32,7 +32,10 @@
 //! and twin re-fits are the default's. `BENCH_BEARINGD=path` runs another build of the daemon (a before/after
 //! comparison on the same machine load). `BENCH_CPU_WAKEUP_US=N` sets the daemon's
 //! `outputs.cpu_wakeup_latency_us` (the CPUs' wake-up latency capped while it runs; left out by
-//! default, as in the default config).
+//! default, as in the default config); `BENCH_CPU_AWAKE=0` (or `1`) sets
+//! `outputs.cpu_awake_during_analysis = false` (`true`): idle CPUs woken for each block's
+//! analysis or not; left out by default, as in the default config (on). Both need write access to `/dev/cpu_dma_latency`:
+//! the summary line says when this user has none (the daemon then runs without them).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
@@ -49,15 +52,24 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+/// What the daemon asks of the CPUs' wake-up latency (docs/DAEMON.md).
+#[derive(Clone, Copy)]
+struct CpuRequests {
+    /// `outputs.cpu_wakeup_latency_us`.
+    cap_us: Option<u32>,
+    /// `outputs.cpu_awake_during_analysis`; `None`: left out (the daemon's default, on; a
+    /// build from before the key, given with `BENCH_BEARINGD`, would refuse it).
+    awake: Option<bool>,
+}
+
 /// `sensors` simulated sensors; sensor j's outer race fails at 2 + 2.5 j s, or at 0 with
-/// `chatter` (then the flags chatter: see the module doc); `cpu_wakeup_us` is
-/// `outputs.cpu_wakeup_latency_us`.
+/// `chatter` (then the flags chatter: see the module doc).
 fn write_config(
     dir: &Path,
     iox: &Path,
     (sensors, rate): (usize, usize),
     chatter: bool,
-    cpu_wakeup_us: Option<u32>,
+    cpu: CpuRequests,
 ) -> PathBuf {
     let mut text = String::new();
     if chatter {
@@ -82,12 +94,35 @@ iceoryx2_root = "{iox}"
         mcap = dir.join("mcap").display(),
         iox = iox.display()
     );
-    if let Some(us) = cpu_wakeup_us {
+    if let Some(us) = cpu.cap_us {
         let _ = writeln!(text, "cpu_wakeup_latency_us = {us}");
+    }
+    if let Some(awake) = cpu.awake {
+        let _ = writeln!(text, "cpu_awake_during_analysis = {awake}");
     }
     let path = dir.join("bench.toml");
     std::fs::write(&path, text).expect("write the bench config");
     path
+}
+
+/// The CPU requests of the run as its summary line says them.
+fn cpu_requests(cpu: CpuRequests, writable: bool, device: &str) -> String {
+    if !writable && (cpu.awake != Some(false) || cpu.cap_us.is_some()) {
+        return format!("CPUs at the kernel's idle policy ({device} not writable by this user)");
+    }
+    let mut said = Vec::new();
+    if let Some(us) = cpu.cap_us {
+        said.push(format!("CPU wake-up capped at {us} µs"));
+    }
+    said.push(
+        match cpu.awake {
+            Some(true) => "CPUs awake during analysis",
+            Some(false) => "CPUs not kept awake during analysis",
+            None => "cpu_awake_during_analysis left to the daemon's default",
+        }
+        .to_string(),
+    );
+    said.join(", ")
 }
 
 fn main() {
@@ -101,10 +136,17 @@ fn main() {
     let rate = env_or("BENCH_RATE", 25_600);
     let windows = env_or("BENCH_WINDOWS", 0);
     let chatter = windows > 0;
-    let cpu_wakeup_us = std::env::var("BENCH_CPU_WAKEUP_US").ok().map(|v| {
-        v.parse()
-            .expect("BENCH_CPU_WAKEUP_US: a whole number of µs")
-    });
+    let cpu = CpuRequests {
+        cap_us: std::env::var("BENCH_CPU_WAKEUP_US").ok().map(|v| {
+            v.parse()
+                .expect("BENCH_CPU_WAKEUP_US: a whole number of µs")
+        }),
+        awake: std::env::var("BENCH_CPU_AWAKE").ok().map(|v| v != "0"),
+    };
+    // Whether the daemon (this user) can make either request: if not, it says so and runs
+    // without, and this run measures the kernel's idle policy.
+    let device = bearingd::daemon::cpu_latency::CPU_LATENCY_DEVICE;
+    let writable = std::fs::OpenOptions::new().write(true).open(device).is_ok();
     let rounds = if chatter {
         1
     } else {
@@ -139,7 +181,7 @@ fn main() {
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("bench dir");
         let iox = dir.join("iox");
-        let config = write_config(&dir, &iox, (sensors, rate), chatter, cpu_wakeup_us);
+        let config = write_config(&dir, &iox, (sensors, rate), chatter, cpu);
         let prefix = format!("bdbench{}_", std::process::id());
         let mut daemon = Command::new(&daemon_path)
             .args([
@@ -201,14 +243,14 @@ fn main() {
     assert!(!latencies_ms.is_empty(), "no alert arrived");
     latencies_ms.sort_by(f64::total_cmp);
     println!(
-        "alert latency, {sensors} sensors at {rate} Hz, {rounds} round(s){}{}: {} alerts ({lost} lost), \
+        "alert latency, {sensors} sensors at {rate} Hz, {rounds} round(s){}, {}: {} alerts ({lost} lost), \
          p50 {:.2} ms, p99 {:.2} ms, p999 {:.2} ms, max {:.2} ms, min {:.2} ms",
         if chatter {
             format!(", {duration_s} s = {windows}+ windows, chattering flags")
         } else {
             String::new()
         },
-        cpu_wakeup_us.map_or(String::new(), |us| format!(", CPU wake-up capped at {us} µs")),
+        cpu_requests(cpu, writable, device),
         latencies_ms.len(),
         percentile(&latencies_ms, 50.0),
         percentile(&latencies_ms, 99.0),

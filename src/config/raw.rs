@@ -185,6 +185,7 @@ pub(crate) struct RawOutputs {
     pub status_interval_s: Field<f64>,
     pub state_save_interval_s: Field<f64>,
     pub cpu_wakeup_latency_us: Field<i64>,
+    pub cpu_awake_during_analysis: Field<bool>,
 }
 
 /// `[severity]`: the machine the ISO 10816-3 / 20816-3 velocity zones are judged for.

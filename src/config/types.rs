@@ -354,6 +354,10 @@ pub struct OutputConfig {
     /// `/dev/cpu_dma_latency`); `None`: the kernel's idle policy.
     #[serde(default)]
     pub cpu_wakeup_latency_us: Option<u32>,
+    /// Idle CPUs kept awake (PM QoS 0 µs) while a block is analysed, so that the alert's
+    /// subscriber wakes on a CPU that is already awake.
+    #[serde(default = "default_cpu_awake_during_analysis")]
+    pub cpu_awake_during_analysis: bool,
 }
 
 impl OutputConfig {
@@ -366,6 +370,11 @@ impl OutputConfig {
     pub fn mcap_disk_budget_bytes(&self) -> u64 {
         self.mcap_disk_budget_mb.saturating_mul(1 << 20)
     }
+}
+
+/// Logs from before `cpu_awake_during_analysis` read as the default.
+fn default_cpu_awake_during_analysis() -> bool {
+    true
 }
 
 /// Logs from before `mcap_fsync_interval_s` read as the default.
@@ -387,6 +396,7 @@ impl Default for OutputConfig {
             status_interval_s: 5.0,
             state_save_interval_s: 60.0,
             cpu_wakeup_latency_us: None,
+            cpu_awake_during_analysis: default_cpu_awake_during_analysis(),
         }
     }
 }

@@ -51,7 +51,9 @@ pub enum DaemonEvent {
     /// The CPUs' wake-up latency is capped at `latency_us` µs while bearingd runs
     /// (`outputs.cpu_wakeup_latency_us`).
     CpuLatencyCapped { latency_us: u32 },
-    /// The cap of `outputs.cpu_wakeup_latency_us` could not be held; bearingd runs on without.
+    /// A request on the PM QoS device (`outputs.cpu_wakeup_latency_us`, or
+    /// `outputs.cpu_awake_during_analysis` at the start or later) could not be held; bearingd
+    /// runs on without it.
     CpuLatencyRefused(super::cpu_latency::CpuLatencyError),
     /// The iceoryx2 root was this user's but readable by others (made by an earlier bearingd
     /// or by iceoryx2, `0750`): it is now `0700`.

@@ -40,7 +40,7 @@
 //! closing ends the analysis thread, which closes the re-fit queue, takes the last fits and
 //! closes the sink queue, which ends the sink thread.
 
-use super::cpu_latency::{CpuLatencyCap, CPU_LATENCY_DEVICE};
+use super::cpu_latency::{CpuLatencyCap, CpusAwake, CPU_LATENCY_DEVICE};
 use super::events::{DaemonEvent, Events};
 use super::lock::{DirLock, LockError};
 use super::sinks::{assemble, SinkPlan, SinkStart, SinkStartError, Sinks};
@@ -202,6 +202,7 @@ pub async fn run(
         state_every: Duration::from_secs_f64(config.outputs.state_save_interval_s),
         state_saved: std::time::Instant::now(),
         events: events.clone(),
+        cpus_awake: cpus_awake_during_analysis(&config, options.realtime, &events),
     };
     let analysis = spawn("analysis", move || analysis.run())?;
 
@@ -271,6 +272,22 @@ fn cap_cpu_latency(config: &Config, events: &Events) -> Option<CpuLatencyCap> {
             None
         }
     }
+}
+
+/// The request of `outputs.cpu_awake_during_analysis` if the config keeps it on and the run is
+/// paced at real time (with `--fast` the analysis never waits for anything, and the CPUs would
+/// poll throughout); one that cannot be opened is reported and the run goes on without it.
+fn cpus_awake_during_analysis(
+    config: &Config,
+    realtime: bool,
+    events: &Events,
+) -> Option<CpusAwake> {
+    if !(config.outputs.cpu_awake_during_analysis && realtime) {
+        return None;
+    }
+    CpusAwake::open(Path::new(CPU_LATENCY_DEVICE))
+        .map_err(|error| events(DaemonEvent::CpuLatencyRefused(error)))
+        .ok()
 }
 
 /// Creates `outputs.state_dir` if it is missing (0750); refuses it if others can write in it.

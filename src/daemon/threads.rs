@@ -4,6 +4,7 @@
 //! thread; and the sink thread. Each owns its state and talks to the others over bounded
 //! channels only.
 
+use super::cpu_latency::CpusAwake;
 use super::events::{DaemonEvent, Events};
 use super::state::save_baselines;
 use crate::messages::{FlagMessage, PipelineMessage};
@@ -85,6 +86,9 @@ pub(super) struct AnalysisThread {
     pub(super) state_every: Duration,
     pub(super) state_saved: std::time::Instant,
     pub(super) events: Events,
+    /// `outputs.cpu_awake_during_analysis`: idle CPUs kept awake while a block is analysed;
+    /// `None` when off or refused.
+    pub(super) cpus_awake: Option<CpusAwake>,
 }
 
 impl AnalysisThread {
@@ -114,9 +118,23 @@ impl AnalysisThread {
     /// they come, then, in their order, to the sink queue.
     fn analyse(&mut self, arrived: Arrived) {
         let Arrived { input, wall_ns } = arrived;
+        self.keep_cpus_awake(true);
         self.deliver(wall_ns, |pipeline, mut out| {
             pipeline.handle(input, &mut out)
         });
+        self.keep_cpus_awake(false);
+    }
+
+    /// Wakes the idle CPUs for a block's analysis (`true`) or lets them halt again (`false`);
+    /// a request the kernel refuses is said once and not made again.
+    fn keep_cpus_awake(&mut self, awake: bool) {
+        let Some(cpus) = self.cpus_awake.as_mut() else {
+            return;
+        };
+        if let Err(error) = cpus.set(awake) {
+            self.cpus_awake = None;
+            (self.events)(DaemonEvent::CpuLatencyRefused(error));
+        }
     }
 
     /// Runs `step` on the pipeline and delivers its outputs (`wall_ns`: when its input arrived).
@@ -310,6 +328,7 @@ mod tests {
             state_every: Duration::MAX,
             state_saved: std::time::Instant::now(),
             events: super::super::ignore_events(),
+            cpus_awake: None,
         }
     }
 
@@ -393,5 +412,54 @@ mod tests {
         // The sink queue is closed: the sink thread ends.
         while queued.try_recv().is_ok() {}
         assert_eq!(queued.try_recv(), Err(mpsc::TryRecvError::Disconnected));
+    }
+
+    /// An immediate sink that keeps nothing.
+    struct Discarding;
+
+    impl Sink for Discarding {
+        fn write(&mut self, _: &PipelineMessage) {}
+        fn finish(&mut self) -> Result<(), SinkError> {
+            Ok(())
+        }
+    }
+
+    fn sensor_lost() -> Arrived {
+        Arrived {
+            input: crate::pipeline::Input::SensorLost {
+                sensor: "motor-de".into(),
+            },
+            wall_ns: 1,
+        }
+    }
+
+    #[test]
+    fn a_block_is_analysed_with_the_cpus_awake_and_they_may_halt_after_it() {
+        let (queue, _queued) = mpsc::sync_channel(SINK_QUEUE);
+        let mut thread = analysis_thread(Box::new(Discarding), queue);
+        let device = bearingd_testdata::scratch_dir("cpus-awake").join("cpu_dma_latency");
+        std::fs::write(&device, b"").unwrap();
+        thread.cpus_awake = Some(CpusAwake::open(&device).unwrap());
+        thread.analyse(sensor_lost());
+        // What the PM QoS device was told, in order: 0 µs for the block, then no constraint.
+        let told = std::fs::read(&device).unwrap();
+        assert_eq!(told[..4], 0i32.to_ne_bytes());
+        assert_eq!(told[4..], 2_000_000_000i32.to_ne_bytes());
+    }
+
+    #[test]
+    fn a_refused_awake_request_is_said_once_and_not_made_again() {
+        let (queue, _queued) = mpsc::sync_channel(SINK_QUEUE);
+        let mut thread = analysis_thread(Box::new(Discarding), queue);
+        let (events, kept) = crate::daemon::events::kept_events();
+        thread.events = events;
+        // Every write to /dev/full fails (no space).
+        thread.cpus_awake = Some(CpusAwake::open(std::path::Path::new("/dev/full")).unwrap());
+        thread.analyse(sensor_lost());
+        thread.analyse(sensor_lost());
+        assert!(thread.cpus_awake.is_none());
+        let kept = kept.lock().unwrap();
+        let refused = kept.iter().filter(|e| e.contains("CpuLatencyRefused"));
+        assert_eq!(refused.count(), 1, "{kept:?}");
     }
 }

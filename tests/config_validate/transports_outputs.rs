@@ -105,6 +105,26 @@ fn the_cpu_wakeup_latency_is_off_unless_given_and_then_within_0_to_1_s() {
 }
 
 #[test]
+fn cpus_are_kept_awake_during_analysis_unless_turned_off_with_a_boolean() {
+    assert!(config_of(SENSOR).outputs.cpu_awake_during_analysis);
+    let off = config_of(&format!(
+        "{SENSOR}[outputs]\ncpu_awake_during_analysis = false\n"
+    ));
+    assert!(!off.outputs.cpu_awake_during_analysis);
+    for bad in ["0", "\"no\""] {
+        let found = problems(&format!(
+            "{SENSOR}[outputs]\ncpu_awake_during_analysis = {bad}\n"
+        ));
+        assert_eq!(
+            keys(&found),
+            ["outputs.cpu_awake_during_analysis"],
+            "{bad}: {found:#?}"
+        );
+        found.iter().for_each(assert_has_fix);
+    }
+}
+
+#[test]
 fn transport_tables_are_checked_even_when_the_transport_is_wrong() {
     let text = SENSOR.replace("\"sim\"", "\"cam\"") + "[sensors.can]\nnode_id = 99\n";
     let found = problems(&text);

@@ -605,18 +605,29 @@ fn the_cpu_wakeup_latency_is_capped_while_the_daemon_runs_and_only_when_asked() 
         return;
     }
     let dir = scratch_dir("daemon-cpu-latency");
-    for capped in [false, true] {
-        let replacement = if capped {
+    // (outputs.cpu_wakeup_latency_us = 0, outputs.cpu_awake_during_analysis): each is a
+    // request of its own on the device, held open for the whole run.
+    for (capped, awake) in [(false, false), (true, true), (false, true)] {
+        let cap = if capped {
             "cpu_wakeup_latency_us = 0"
         } else {
             "# cpu_wakeup_latency_us = 0"
         };
+        let awake_line = if awake {
+            "# cpu_awake_during_analysis = true"
+        } else {
+            "cpu_awake_during_analysis = false"
+        };
+        let name = format!("cap-{capped}-awake-{awake}");
         let config = config_with(
             &dir,
-            &format!("cap-{capped}"),
-            &[("# cpu_wakeup_latency_us = 0", replacement)],
+            &name,
+            &[
+                ("# cpu_wakeup_latency_us = 0", cap),
+                ("# cpu_awake_during_analysis = true", awake_line),
+            ],
         );
-        let data = dir.join(format!("data-{capped}"));
+        let data = dir.join(format!("data-{name}"));
         let child = Command::new(env!("CARGO_BIN_EXE_bearingd"))
             .args(["run", "--quiet", "--duration", "3", "--config"])
             .arg(&config)
@@ -626,21 +637,28 @@ fn the_cpu_wakeup_latency_is_capped_while_the_daemon_runs_and_only_when_asked() 
             .stderr(Stdio::piped())
             .spawn()
             .unwrap();
-        // Looked at every 50 ms from the start to the exit: an uncapped run must never hold it.
+        // Looked at every 50 ms from the start to the exit: a run that asks for neither must
+        // never hold the device.
+        let expected = usize::from(capped) + usize::from(awake);
         let mut child = child;
-        let mut holds = false;
-        while child.try_wait().unwrap().is_none() && !(capped && holds) {
-            holds |= open_files(child.id()).iter().any(|f| f == device);
+        let mut most_held = 0;
+        while child.try_wait().unwrap().is_none() && !(expected > 0 && most_held == expected) {
+            let held = open_files(child.id())
+                .iter()
+                .filter(|f| *f == device)
+                .count();
+            most_held = most_held.max(held);
             std::thread::sleep(std::time::Duration::from_millis(50));
         }
         let out = child.wait_with_output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{stderr}");
-        assert_eq!(holds, capped, "capped {capped}: {stderr}");
+        assert_eq!(most_held, expected, "{name}: {stderr}");
         assert_eq!(
             stderr.contains("CPU wake-up latency capped at 0 µs"),
             capped,
             "{stderr}"
         );
+        assert!(!stderr.contains("cannot hold it"), "{name}: {stderr}");
     }
 }

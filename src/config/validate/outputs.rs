@@ -128,6 +128,13 @@ impl Checker {
              state_save_interval_s = 60.0",
         );
         let cpu_wakeup_latency_us = self.cpu_wakeup_latency(&raw.cpu_wakeup_latency_us);
+        let cpu_awake_during_analysis = self.or_default(
+            "outputs.cpu_awake_during_analysis",
+            &raw.cpu_awake_during_analysis,
+            d.cpu_awake_during_analysis,
+            "give true to keep idle CPUs awake while a block is analysed (alerts reach \
+             subscribers sooner) or false, e.g. cpu_awake_during_analysis = true",
+        );
         Some(OutputConfig {
             state_dir: state_dir?,
             mcap_dir: mcap_dir?,
@@ -140,6 +147,7 @@ impl Checker {
             status_interval_s: status_interval_s?,
             state_save_interval_s: state_save_interval_s?,
             cpu_wakeup_latency_us: cpu_wakeup_latency_us?,
+            cpu_awake_during_analysis: cpu_awake_during_analysis?,
         })
     }
 
