@@ -14,7 +14,8 @@
 //! once (the kernel re-selects their idle state), in parallel with the block's FFT, so the CPU
 //! the alert's subscriber sleeps on is awake and polling by the time the alert is published;
 //! writing the default back when the block is done lets them halt again. The CPUs poll for the
-//! analysis alone (a few % of the time with 16 channels), not for the whole run.
+//! analysis alone (1.5 % of the CPUs' time with 16 channels, docs/PERFORMANCE.md), not for
+//! the whole run.
 
 use std::fs::{File, OpenOptions};
 use std::io::Write as _;
@@ -97,16 +98,24 @@ fn fix_for(kind: std::io::ErrorKind, request: CpuLatencyRequest) -> String {
     }
 }
 
+/// The error of `request` on `device`, for `map_err`.
+fn refused(
+    request: CpuLatencyRequest,
+    device: &Path,
+) -> impl Fn(std::io::Error) -> CpuLatencyError + '_ {
+    move |source| CpuLatencyError {
+        request,
+        device: device.to_path_buf(),
+        source,
+    }
+}
+
 /// Opens the PM QoS device: a new request of this process, unconstrained until written.
 fn open_request(device: &Path, request: CpuLatencyRequest) -> Result<File, CpuLatencyError> {
     OpenOptions::new()
         .write(true)
         .open(device)
-        .map_err(|source| CpuLatencyError {
-            request,
-            device: device.to_path_buf(),
-            source,
-        })
+        .map_err(refused(request, device))
 }
 
 /// Sets this process's request on an open device to `latency_us` (the kernel takes a
@@ -120,11 +129,7 @@ impl CpuLatencyCap {
     /// [`CPU_LATENCY_DEVICE`]) until the returned cap is dropped.
     pub fn hold(device: &Path, latency_us: u32) -> Result<CpuLatencyCap, CpuLatencyError> {
         let request = CpuLatencyRequest::Cap { latency_us };
-        let failed = |source| CpuLatencyError {
-            request,
-            device: device.to_path_buf(),
-            source,
-        };
+        let failed = refused(request, device);
         let value = i32::try_from(latency_us).map_err(|_| {
             failed(std::io::Error::new(
                 std::io::ErrorKind::InvalidInput,
@@ -159,11 +164,10 @@ impl CpusAwake {
     /// done (they may halt again).
     pub fn set(&mut self, awake: bool) -> Result<(), CpuLatencyError> {
         let latency_us = if awake { 0 } else { UNCONSTRAINED_US };
-        write_request(&mut self.file, latency_us).map_err(|source| CpuLatencyError {
-            request: CpuLatencyRequest::AwakeDuringAnalysis,
-            device: self.device.clone(),
-            source,
-        })
+        write_request(&mut self.file, latency_us).map_err(refused(
+            CpuLatencyRequest::AwakeDuringAnalysis,
+            &self.device,
+        ))
     }
 }
 
