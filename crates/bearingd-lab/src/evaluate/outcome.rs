@@ -108,6 +108,73 @@ pub struct MonitorOutcome {
     pub predicted: Predicted,
 }
 
+/// Counts the windows scored after the first band selection and those of them that closed
+/// with a flag up. A window counts by its end sample: scored if it ended after the first
+/// selection's sample, flagged by the levels in force when it ended. The monitor decides a
+/// selection's flags before it finishes the newest window's band work (the alert must not
+/// wait for it), so that window's report may come after the selection and a flag change at a
+/// later sample. A flag changes at most once between two reports.
+#[derive(Debug, Clone, Copy)]
+pub struct WindowFlagCount {
+    /// The first band selection's sample.
+    first_selection: Option<u64>,
+    /// Each flag's level now, and before its latest change with that change's sample.
+    levels: [FlagLevel; 4],
+    before_change: [(FlagLevel, u64); 4],
+    pub scored: u64,
+    pub flagged: u64,
+}
+
+impl Default for WindowFlagCount {
+    fn default() -> Self {
+        WindowFlagCount {
+            first_selection: None,
+            levels: [FlagLevel::Ok; 4],
+            before_change: [(FlagLevel::Ok, 0); 4],
+            scored: 0,
+            flagged: 0,
+        }
+    }
+}
+
+impl WindowFlagCount {
+    /// A band selection was used at `at_sample`.
+    pub fn selection(&mut self, at_sample: u64) {
+        self.first_selection.get_or_insert(at_sample);
+    }
+
+    /// The first band selection's sample, once there was one.
+    pub fn first_selection(&self) -> Option<u64> {
+        self.first_selection
+    }
+
+    /// `fault`'s flag changed to `to` at sample `at_sample`.
+    pub fn flag_changed(&mut self, fault: FaultKind, to: FlagLevel, at_sample: u64) {
+        let i = fault.index();
+        self.before_change[i] = (self.levels[i], at_sample);
+        self.levels[i] = to;
+    }
+
+    /// The report of a window that ended at `end_sample`.
+    pub fn window(&mut self, end_sample: u64) {
+        if self.first_selection.is_none_or(|at| end_sample <= at) {
+            return;
+        }
+        self.scored += 1;
+        let raised = self
+            .levels
+            .iter()
+            .zip(&self.before_change)
+            .any(|(&now, &(before, at))| {
+                let level = if end_sample > at { now } else { before };
+                level > FlagLevel::Ok
+            });
+        if raised {
+            self.flagged += 1;
+        }
+    }
+}
+
 /// One case's results.
 #[derive(Debug, Clone, Serialize)]
 pub struct CaseResult {
@@ -196,5 +263,25 @@ mod tests {
             Predicted::Ambiguous(Verdict::BallOrInner).name(),
             "ball_or_inner"
         );
+    }
+
+    /// A window counts by its end sample, whenever its report comes: scored once it ended after
+    /// the first selection, flagged by the levels in force when it ended.
+    #[test]
+    fn a_window_counts_with_the_levels_in_force_at_its_end() {
+        let mut count = WindowFlagCount::default();
+        count.window(100);
+        count.selection(200);
+        count.flag_changed(FaultKind::OuterRace, FlagLevel::Watch, 200);
+        // Reports that came after the selection and its flag, of windows that ended before.
+        count.window(150);
+        count.window(200);
+        assert_eq!((count.scored, count.flagged), (0, 0));
+        count.window(250);
+        count.flag_changed(FaultKind::OuterRace, FlagLevel::Ok, 400);
+        count.window(380);
+        count.window(450);
+        assert_eq!((count.scored, count.flagged), (3, 2));
+        assert_eq!(count.first_selection(), Some(200));
     }
 }

@@ -7,7 +7,7 @@
 //!   as the sensor's integer counts in blocks with their sample positions, in sample time.
 
 use super::agreement::grid_verdicts;
-use super::outcome::{CaseResult, MonitorOutcome, Predicted, RecordOutcome};
+use super::outcome::{CaseResult, MonitorOutcome, Predicted, RecordOutcome, WindowFlagCount};
 use super::sweep::{Case, Machine, NoiseLevel, Sweep, DEFAULT_SEVERITY};
 use crate::analysis::agreement::Witness;
 use crate::analysis::diagnosis::DecisionRule;
@@ -320,12 +320,10 @@ pub struct MonitorWatch {
     fs_hz: f64,
     rule: DecisionRule,
     strongest: Option<StrongestEvidence>,
-    level: [FlagLevel; 4],
     highest: [FlagLevel; 4],
     rises: Vec<FlagRise>,
     decisions: u64,
-    windows_scored: u64,
-    windows_flagged: u64,
+    windows: WindowFlagCount,
 }
 
 impl MonitorWatch {
@@ -335,12 +333,10 @@ impl MonitorWatch {
             fs_hz: settings.fs_hz,
             rule: settings.analysis.decision_rule(),
             strongest: None,
-            level: [FlagLevel::Ok; 4],
             highest: [FlagLevel::Ok; 4],
             rises: Vec::new(),
             decisions: 0,
-            windows_scored: 0,
-            windows_flagged: 0,
+            windows: WindowFlagCount::default(),
         }
     }
 
@@ -352,6 +348,7 @@ impl MonitorWatch {
                 ..
             } => {
                 self.decisions += 1;
+                self.windows.selection(at_sample);
                 for score in evidence.iter().flat_map(|e| e.scores.iter()) {
                     let margin = self.rule.naming_margin(score);
                     if self.strongest.is_none_or(|s| margin > s.margin) {
@@ -373,7 +370,8 @@ impl MonitorWatch {
                 runner_up,
             } => {
                 let index = FaultKind::ALL.iter().position(|&k| k == fault).unwrap_or(0);
-                self.level[index] = change.to;
+                self.windows
+                    .flag_changed(fault, change.to, change.at_sample);
                 self.highest[index] = self.highest[index].max(change.to);
                 if change.from == FlagLevel::Ok && change.to > FlagLevel::Ok {
                     self.rises.push(FlagRise {
@@ -386,12 +384,7 @@ impl MonitorWatch {
                     });
                 }
             }
-            MonitorEvent::Window(_) if self.decisions > 0 => {
-                self.windows_scored += 1;
-                if self.level.iter().any(|&l| l > FlagLevel::Ok) {
-                    self.windows_flagged += 1;
-                }
-            }
+            MonitorEvent::Window(w) => self.windows.window(w.end_sample),
             _ => {}
         }
     }
@@ -414,8 +407,8 @@ impl MonitorWatch {
         MonitorOutcome {
             highest: self.highest,
             first_flag_s: self.rises.first().map(|rise| rise.at_s),
-            windows_scored: self.windows_scored,
-            windows_flagged: self.windows_flagged,
+            windows_scored: self.windows.scored,
+            windows_flagged: self.windows.flagged,
             predicted: Predicted::of_flags(self.highest),
         }
     }

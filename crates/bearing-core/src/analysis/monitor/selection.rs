@@ -47,9 +47,16 @@ impl ChannelMonitor {
     }
 
     /// Takes the result of the selection under way (waiting for it if it is not done) and
-    /// follows its speed estimate and its bands.
+    /// follows its speed estimate, its verdict and its bands.
+    ///
+    /// The flags come before the newest window's band work still to be done (its report,
+    /// scored on the bands it was taken with) and before the new bands' set-up: they follow
+    /// the verdict alone, and the alerts they decide must not wait for that work (150–290 µs
+    /// of a fault alert's latency in the daemon, where the band work is spread over the hop).
+    /// So that window's report may come after a flag change at a later sample; it counts with
+    /// the levels before it (`WindowFlagCount` in the lab). A speed estimate is the exception:
+    /// the window is scored at the speed it was taken at, before the estimate is applied.
     pub(super) fn use_band_result(&mut self, on_event: &mut impl FnMut(MonitorEvent)) {
-        self.finish_window(on_event);
         self.band_result_at = None;
         let Some(BandResult {
             estimated_shaft_hz,
@@ -57,19 +64,14 @@ impl ChannelMonitor {
             evidence,
         }) = self.band_selector.finish()
         else {
-            return;
+            return self.finish_window(on_event);
         };
         if let Some(hz) = estimated_shaft_hz {
             self.apply_speed(Some(hz), true, on_event);
         }
         let Some((bands, selected)) = bands.filter(|_| self.speed_known) else {
-            return;
+            return self.finish_window(on_event);
         };
-        if !self.bands_known || bands != self.bands {
-            self.rolling.set_bands(&bands);
-            self.bands = bands;
-        }
-        self.bands_known = true;
         on_event(MonitorEvent::Bands {
             at_sample: self.next_sample,
             bands,
@@ -83,6 +85,12 @@ impl ChannelMonitor {
         {
             self.follow_evidence(&evidence, on_event);
         }
+        self.finish_window(on_event);
+        if !self.bands_known || bands != self.bands {
+            self.rolling.set_bands(&bands);
+            self.bands = bands;
+        }
+        self.bands_known = true;
     }
 
     /// The flags follow the verdict on the selection's history: the fault it names asks for

@@ -35,7 +35,7 @@ pub mod tally;
 pub use manifest::{Manifest, ManifestError, ManifestRecord, Truth};
 pub use tally::{render_recordings, tally, Said, Tally};
 
-use super::outcome::{MonitorOutcome, Predicted, RecordOutcome};
+use super::outcome::{MonitorOutcome, Predicted, RecordOutcome, WindowFlagCount};
 use super::run::record_outcome;
 use crate::analysis::agreement::{Agreement, Witness};
 use crate::analysis::record::RecordAnalyzer;
@@ -438,22 +438,16 @@ pub fn evaluate_task(
 #[derive(Debug)]
 struct Watched {
     flags: Vec<FlagChange>,
-    level: [FlagLevel; 4],
     highest: [FlagLevel; 4],
-    bands_at_sample: Option<u64>,
-    windows_scored: u64,
-    windows_flagged: u64,
+    windows: WindowFlagCount,
 }
 
 impl Default for Watched {
     fn default() -> Self {
         Watched {
             flags: Vec::new(),
-            level: [FlagLevel::Ok; 4],
             highest: [FlagLevel::Ok; 4],
-            bands_at_sample: None,
-            windows_scored: 0,
-            windows_flagged: 0,
+            windows: WindowFlagCount::default(),
         }
     }
 }
@@ -471,7 +465,7 @@ impl Sink for Watcher {
         match message {
             PipelineMessage::Flag(flag) => {
                 let index = flag.fault.index();
-                w.level[index] = flag.to;
+                w.windows.flag_changed(flag.fault, flag.to, flag.end_sample);
                 w.highest[index] = w.highest[index].max(flag.to);
                 w.flags.push(FlagChange {
                     fault: flag.fault,
@@ -482,14 +476,9 @@ impl Sink for Watcher {
                 });
             }
             PipelineMessage::Health(health) if health.kind == HealthKind::Bands => {
-                w.bands_at_sample.get_or_insert(health.end_sample);
+                w.windows.selection(health.end_sample);
             }
-            PipelineMessage::Indicators(_) if w.bands_at_sample.is_some() => {
-                w.windows_scored += 1;
-                if w.level.iter().any(|&l| l > FlagLevel::Ok) {
-                    w.windows_flagged += 1;
-                }
-            }
+            PipelineMessage::Indicators(window) => w.windows.window(window.end_sample),
             _ => {}
         }
     }
@@ -563,14 +552,14 @@ fn replay_imported(
     }
     let w = std::mem::take(&mut *watched.lock().unwrap_or_else(|e| e.into_inner()));
     let on_delay_s = config.thresholds.on_delay_s;
-    let bands_at_s = w.bands_at_sample.map(|at| at as f64 / fs_hz);
+    let bands_at_s = w.windows.first_selection().map(|at| at as f64 / fs_hz);
     match bands_at_s {
         Some(at) if on_delay_s <= seconds => DaemonOutcome::Judged {
             monitor: MonitorOutcome {
                 highest: w.highest,
                 first_flag_s: w.flags.iter().find(|f| f.to > f.from).map(|f| f.at_s),
-                windows_scored: w.windows_scored,
-                windows_flagged: w.windows_flagged,
+                windows_scored: w.windows.scored,
+                windows_flagged: w.windows.flagged,
                 predicted: Predicted::of_flags(w.highest),
             },
             flags: w.flags,
