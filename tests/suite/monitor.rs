@@ -572,36 +572,19 @@ fn a_window_stagger_moves_every_window_end_by_its_share_of_the_hop() {
     }
 }
 
-/// Runs each band job when its result is asked for: the daemon's band worker, whose result is
-/// used a fixed number of samples after the job started, without the thread.
-#[derive(Default)]
-struct RunWhenAsked {
-    jobs: std::collections::VecDeque<std::sync::Arc<bearingd::analysis::band_selection::BandJob>>,
-}
-
-impl bearingd::analysis::band_selection::BandSelector for RunWhenAsked {
-    fn start(&mut self, job: std::sync::Arc<bearingd::analysis::band_selection::BandJob>) {
-        self.jobs.push_back(job);
-    }
-
-    fn finish(&mut self) -> Option<bearingd::analysis::band_selection::BandResult> {
-        let job = self.jobs.pop_front()?;
-        Some(job.run(&mut bearingd::analysis::envelope::FftPlans::shared()))
-    }
-}
-
 /// A band selection's result used while the newest window's band work still waits (the daemon
 /// spreads that work over the hop): the flags it decides come out right after its bands event,
 /// so their alerts do not wait for that work; the window's report follows, with its own end
-/// sample (before the flag's).
+/// sample (before the flag's). The selections run on the daemon's band worker.
 #[test]
 fn a_selections_flags_come_before_the_report_of_a_window_still_waiting_for_its_bands() {
     let (counts, params) = counts(30.0, 0.0);
     // Each band selection's result used `delay` samples after it started; every flag, window
     // report and bands event in order, with its sample.
+    let worker = bearingd::pipeline::bands::BandWorker::start(1).expect("the band worker starts");
     let run = |delay: u64| {
         let mut monitor = ChannelMonitor::new(settings(params.fs_hz), params.frequencies(), None)
-            .with_band_selector(Box::new(RunWhenAsked::default()), delay, 0);
+            .with_band_selector(Box::new(worker.selector()), delay, 0);
         let mut events = Vec::new();
         for (k, chunk) in counts.chunks(2_560).enumerate() {
             monitor.push_counts((k * 2_560) as u64, chunk, SCALE, &mut |e| match e {
@@ -632,8 +615,8 @@ fn a_selections_flags_come_before_the_report_of_a_window_still_waiting_for_its_b
         .position(|&event| event == ("flag", at))
         .unwrap_or_else(|| panic!("no flag raised at {at}: {events:?}"));
     assert_eq!(
-        events[flag - 1],
-        ("bands", at),
+        flag.checked_sub(1).map(|before| events[before]),
+        Some(("bands", at)),
         "the selection's bands event, then its flags: {events:?}"
     );
     let next_window = events[flag..].iter().find(|&&(kind, _)| kind == "window");

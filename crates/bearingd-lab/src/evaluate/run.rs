@@ -369,7 +369,7 @@ impl MonitorWatch {
                 frequency_hz,
                 runner_up,
             } => {
-                let index = FaultKind::ALL.iter().position(|&k| k == fault).unwrap_or(0);
+                let index = fault.index();
                 self.windows
                     .flag_changed(fault, change.to, change.at_sample);
                 self.highest[index] = self.highest[index].max(change.to);
