@@ -52,10 +52,10 @@ fn sub(out: &mut Vec<u8>, ty: u32, data: &[u8]) {
     pad8(out);
 }
 
-/// A double matrix variable; `imag` makes it complex.
-fn mat_var(name: &str, rows: usize, cols: usize, real: &[f64], imag: Option<&[f64]>) -> Vec<u8> {
+/// The first sub-elements of a `miMATRIX`: array flags (class and complex bit), a 2-D size,
+/// the name.
+fn array_header(flags: u32, rows: i32, cols: i32, name: &str) -> Vec<u8> {
     let mut body = Vec::new();
-    let flags: u32 = 6 | if imag.is_some() { 0x0800 } else { 0 };
     sub(
         &mut body,
         6,
@@ -64,9 +64,16 @@ fn mat_var(name: &str, rows: usize, cols: usize, real: &[f64], imag: Option<&[f6
     sub(
         &mut body,
         5,
-        &[(rows as i32).to_le_bytes(), (cols as i32).to_le_bytes()].concat(),
+        &[rows.to_le_bytes(), cols.to_le_bytes()].concat(),
     );
     sub(&mut body, 1, name.as_bytes());
+    body
+}
+
+/// A double matrix variable; `imag` makes it complex.
+fn mat_var(name: &str, rows: usize, cols: usize, real: &[f64], imag: Option<&[f64]>) -> Vec<u8> {
+    let flags: u32 = 6 | if imag.is_some() { 0x0800 } else { 0 };
+    let mut body = array_header(flags, rows as i32, cols as i32, name);
     let f64s = |v: &[f64]| v.iter().flat_map(|x| x.to_le_bytes()).collect::<Vec<u8>>();
     sub(&mut body, 9, &f64s(real));
     if let Some(im) = imag {
@@ -197,6 +204,36 @@ fn mat_matrices_complex_and_empty_variables_are_refused() {
         e.contains("2 NaN or infinite") && e.contains("sample index 1"),
         "{e}"
     );
+}
+
+/// A struct variable of `rows`x`cols` elements with no fields (MATLAB's `repmat(struct(), r, c)`).
+fn mat_struct_without_fields(name: &str, rows: i32, cols: i32) -> Vec<u8> {
+    let mut body = array_header(2, rows, cols, name);
+    sub(&mut body, 5, &32i32.to_le_bytes());
+    sub(&mut body, 1, &[]);
+    let mut el = Vec::new();
+    sub(&mut el, 14, &body);
+    el
+}
+
+/// Found by the `recordings` fuzz target: a 4,194,305-element struct with no fields, in 2 kB,
+/// made the reader reserve 96 MiB (one empty element each). It is now listed, and costs nothing.
+#[test]
+fn mat_struct_with_no_fields_is_listed_whatever_its_size() {
+    let dir = scratch_dir("mat-struct-no-fields");
+    let vars = [
+        mat_struct_without_fields("huge", 0x0040_0001, 1),
+        mat_struct_without_fields("one", 1, 1),
+    ];
+    let path = write(&dir, "no_fields.mat", &mat_file(&vars));
+    let e = err(&path, &ReadOptions::default());
+    assert!(
+        e.contains("huge (4194305x1 struct with no fields)")
+            && e.contains("one (1x1 struct with no fields)"),
+        "{e}"
+    );
+    let e = err(&path, &channel("huge"));
+    assert!(e.contains("struct with no fields"), "{e}");
 }
 
 #[test]

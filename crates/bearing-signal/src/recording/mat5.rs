@@ -730,6 +730,14 @@ fn structure(
             String::from_utf8_lossy(&c[..end]).into_owned()
         })
         .collect();
+    // A struct with no fields holds nothing to read, whatever its size; keeping one empty
+    // element per index would let a few bytes claim gigabytes.
+    if fields.is_empty() {
+        return Ok(Value::Other {
+            dims,
+            kind: "struct with no fields",
+        });
+    }
     let count = numel.saturating_mul(fields.len());
     // Every field value takes at least an 8-byte tag: more than fits is damage.
     if count > r.remaining() / 8 {
