@@ -38,6 +38,9 @@
 //! `outputs.cpu_awake_during_analysis = false` (`true`): idle CPUs woken for each block's
 //! analysis or not; left out by default, as in the default config (on). Both need write access to `/dev/cpu_dma_latency`:
 //! the summary line says when this user has none (the daemon then runs without them).
+//!
+//! A last line says how the alerts came per input ([`InputGroups`]): alone, or several from
+//! one input, and how far apart.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
@@ -183,6 +186,7 @@ fn main() {
     // the path of the alerts a maintenance engineer acts on (the rest are per-window flags).
     let mut fault_latencies_ms = Vec::new();
     let mut lost = 0u64;
+    let mut inputs = InputGroups::default();
     for round in 0..rounds {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("alert-latency-{round}"));
         let _ = std::fs::remove_dir_all(&dir);
@@ -232,6 +236,7 @@ fn main() {
                 Some(Received::Alert(alert)) => {
                     let latency_ms = (wall_clock_now_ns() as f64 - alert.wall_time_ns as f64) / 1e6;
                     latencies_ms.push(latency_ms);
+                    inputs.add(alert.wall_time_ns, latency_ms);
                     if FaultKind::ALL
                         .iter()
                         .any(|&kind| fault_code(kind) == alert.fault)
@@ -281,6 +286,56 @@ fn main() {
         percentile(&fault_latencies_ms, 99.0),
         fault_latencies_ms.last().copied().unwrap_or(f64::NAN),
     );
+    println!("{}", inputs.summary());
     println!("{host}");
     println!("{wake}");
+}
+
+/// How the alerts came per input (the alerts of one input carry its arrival stamp): alone, or
+/// several together, and how long a later alert of an input came after the one before it (the
+/// cost of one more alert while the subscriber is awake). It says whether one wake-up per
+/// input instead of per alert could shorten the tail (it cannot when nearly all come alone).
+#[derive(Default)]
+struct InputGroups {
+    /// The current input's stamp and its last alert's latency.
+    last: Option<(u64, f64)>,
+    /// Alerts per input, for inputs with at least one.
+    sizes: Vec<usize>,
+    /// A later alert of an input: its latency minus the previous alert's, in ms.
+    later_gaps_ms: Vec<f64>,
+}
+
+impl InputGroups {
+    fn add(&mut self, arrived_ns: u64, latency_ms: f64) {
+        match self.last {
+            Some((stamp, before_ms)) if stamp == arrived_ns => {
+                self.later_gaps_ms.push(latency_ms - before_ms);
+                if let Some(size) = self.sizes.last_mut() {
+                    *size += 1;
+                }
+            }
+            _ => self.sizes.push(1),
+        }
+        self.last = Some((arrived_ns, latency_ms));
+    }
+
+    fn summary(&mut self) -> String {
+        let alone = self.sizes.iter().filter(|&&n| n == 1).count();
+        let together: usize = self.sizes.iter().filter(|&&n| n > 1).sum();
+        let inputs = self.sizes.iter().filter(|&&n| n > 1).count();
+        let largest = self.sizes.iter().copied().max().unwrap_or(0);
+        self.later_gaps_ms.sort_by(f64::total_cmp);
+        let gaps = if self.later_gaps_ms.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; a later alert of an input came p50 {:.1} µs, max {:.1} µs after the one before",
+                percentile(&self.later_gaps_ms, 50.0) * 1e3,
+                self.later_gaps_ms.last().unwrap() * 1e3
+            )
+        };
+        format!(
+            "alerts per input: {alone} alone, {together} in {inputs} inputs of 2 to {largest}{gaps}"
+        )
+    }
 }
