@@ -39,8 +39,11 @@
 //! analysis or not; left out by default, as in the default config (on). Both need write access to `/dev/cpu_dma_latency`:
 //! the summary line says when this user has none (the daemon then runs without them).
 //!
-//! A last line says how the alerts came per input ([`InputGroups`]): alone, or several from
-//! one input, and how far apart.
+//! A line says how the alerts came per input ([`InputGroups`]): alone, or several from
+//! one input, and how far apart; one per round, the daemon's own part of the latency
+//! (`alerts_in_service` of its summary: its input's arrival to the alert in shared memory,
+//! before the subscriber is woken), so a run on any machine tells the daemon's time from the
+//! machine's wake-up.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 mod common;
@@ -56,7 +59,7 @@ use common::{
 };
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 use std::time::{Duration, Instant};
 
 /// What the daemon asks of the CPUs' wake-up latency (docs/DAEMON.md).
@@ -187,6 +190,7 @@ fn main() {
     let mut fault_latencies_ms = Vec::new();
     let mut lost = 0u64;
     let mut inputs = InputGroups::default();
+    let mut in_service = Vec::new();
     for round in 0..rounds {
         let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("alert-latency-{round}"));
         let _ = std::fs::remove_dir_all(&dir);
@@ -194,17 +198,20 @@ fn main() {
         let iox = dir.join("iox");
         let config = write_config(&dir, &iox, (sensors, rate), chatter, cpu);
         let prefix = format!("bdbench{}_", std::process::id());
+        let daemon_out = dir.join("daemon.ndjson");
         let mut daemon = Command::new(&daemon_path)
             .args([
                 "run",
                 "--quiet",
+                "--format",
+                "json",
                 "--duration",
                 &duration_s.to_string(),
                 "--config",
             ])
             .arg(&config)
             .env("BEARINGD_IOX_PREFIX", &prefix)
-            .stdout(Stdio::null())
+            .stdout(std::fs::File::create(&daemon_out).expect("daemon output file"))
             .spawn()
             .expect("start bearingd");
         let settings = AlertServiceSettings {
@@ -257,6 +264,7 @@ fn main() {
         }
         let _ = daemon.wait();
         eprintln!("round {round}: {round_alerts} alerts");
+        in_service.push(daemon_in_service(&daemon_out));
     }
     assert!(!latencies_ms.is_empty(), "no alert arrived");
     latencies_ms.sort_by(f64::total_cmp);
@@ -287,8 +295,38 @@ fn main() {
         fault_latencies_ms.last().copied().unwrap_or(f64::NAN),
     );
     println!("{}", inputs.summary());
+    for (round, spread) in in_service.iter().enumerate() {
+        println!("round {round}, the daemon's own part: {spread}");
+    }
     println!("{host}");
     println!("{wake}");
+}
+
+/// The daemon's own part of its alerts' latency, from its summary (`run --format json`, last
+/// line): how long after its input arrived each alert was in the service, before the
+/// subscriber's wake-up. The rest of an alert's latency is that wake-up, this machine's.
+fn daemon_in_service(out: &Path) -> String {
+    let text = std::fs::read_to_string(out).expect("the daemon's output");
+    let summary: serde_json::Value = text
+        .lines()
+        .rev()
+        .find_map(|line| {
+            serde_json::from_str::<serde_json::Value>(line)
+                .ok()
+                .filter(|v| v["type"] == "summary")
+        })
+        .unwrap_or_else(|| panic!("no summary line in {}", out.display()));
+    let d = &summary["alerts_in_service"];
+    let ms = |key: &str| d[key].as_f64().map_or(f64::NAN, |us| us / 1e3);
+    format!(
+        "{} alerts in the service p50 {:.2} ms, p90 {:.2} ms, p99 {:.2} ms, max {:.2} ms \
+         after their input arrived (receipt adds the subscriber's wake-up)",
+        d["alerts"],
+        ms("p50_us"),
+        ms("p90_us"),
+        ms("p99_us"),
+        ms("max_us")
+    )
 }
 
 /// How the alerts came per input (the alerts of one input carry its arrival stamp): alone, or

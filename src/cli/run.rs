@@ -118,6 +118,18 @@ fn message_json(message: &PipelineMessage) -> Option<serde_json::Value> {
     }
 }
 
+/// The daemon's part of the alerts' latency, for the summary line.
+fn in_service_text(d: &crate::sinks::alerts::DelaySpread) -> String {
+    let ms = |us: u64| us as f64 / 1e3;
+    format!(
+        ", each in the service p50 {:.2} ms, p99 {:.2} ms, max {:.2} ms after its input arrived \
+         (the subscribers' wake-up comes on top)",
+        ms(d.p50_us),
+        ms(d.p99_us),
+        ms(d.max_us)
+    )
+}
+
 /// `value` as a JSON object with `"type": kind` added (a line of `--format json`).
 fn typed(kind: &str, value: &impl serde::Serialize) -> serde_json::Value {
     let mut value = serde_json::to_value(value).unwrap_or_default();
@@ -195,7 +207,7 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
         return Ok(());
     }
     println!(
-        "summary: {} messages, {} twin fits ({} dropped), {} alerts published{}",
+        "summary: {} messages, {} twin fits ({} dropped), {} alerts published{}{}",
         summary.messages,
         summary.twin_fits,
         summary.twin_requests_skipped,
@@ -207,7 +219,11 @@ pub fn run_command(args: &RunArgs) -> Result<(), CliError> {
             )
         } else {
             String::new()
-        }
+        },
+        summary
+            .alerts_in_service
+            .map(|d| in_service_text(&d))
+            .unwrap_or_default()
     );
     for channel in &summary.channels {
         println!("  {}", status_line(channel));

@@ -123,6 +123,9 @@ pub struct RunSummary {
     pub alerts_published: u64,
     /// Alerts iceoryx2 refused (reported as they happen).
     pub alerts_failed: u64,
+    /// How long after their input arrived the published alerts were in the service (the
+    /// daemon's part of their latency; the subscribers' wake-up comes on top).
+    pub alerts_in_service: Option<crate::sinks::alerts::DelaySpread>,
 }
 
 /// Inputs waiting for the analysis thread, at most.
@@ -255,6 +258,7 @@ pub async fn run(
         twin_requests_skipped: analysis.requests_skipped,
         alerts_published: alerts.map_or(0, |s| s.published),
         alerts_failed: alerts.map_or(0, |s| s.failed),
+        alerts_in_service: alerts.and_then(|s| s.in_service),
     })
 }
 

@@ -78,6 +78,11 @@ fn a_python_subscriber_receives_the_raised_alert_of_a_simulated_fault() {
         stdout.contains("1 alerts published") || stdout.contains("2 alerts published"),
         "{stdout}"
     );
+    // The daemon's own part of their latency, before the subscriber's wake-up.
+    assert!(
+        stdout.contains(", each in the service p50 ") && stdout.contains("after its input arrived"),
+        "{stdout}"
+    );
 
     let received = subscriber.wait_with_output().unwrap();
     let text = String::from_utf8_lossy(&received.stdout);

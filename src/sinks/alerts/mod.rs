@@ -7,6 +7,8 @@
 //! `docs/ALERTS.md`.
 //!
 //! - [`payload`]: the `#[repr(C)]` record and its readable view.
+//! - [`delay`]: how long after its input each alert was in the service (the daemon's part of
+//!   its latency), for the run's summary.
 //! - [`sequence`]: a subscriber's check of sequence numbers (sans-IO): losses, duplicates,
 //!   restarts, and jumps that cannot be trusted.
 //! - [`service`]: the iceoryx2 publisher and subscriber.
@@ -14,6 +16,7 @@
 //!   analysis thread: an alert leaves as soon as it is decided, never behind the MCAP log or
 //!   another thread's wake-up.
 
+pub mod delay;
 pub mod payload;
 pub mod sequence;
 #[cfg(feature = "shm")]
@@ -21,6 +24,7 @@ pub mod service;
 #[cfg(feature = "shm")]
 mod verify;
 
+pub use delay::DelaySpread;
 pub use payload::{Alert, AlertState, AlertView};
 #[cfg(feature = "shm")]
 pub use service::{AlertError, AlertPublisher, AlertServiceSettings};
@@ -31,6 +35,9 @@ pub struct PublisherSummary {
     pub published: u64,
     /// Alerts iceoryx2 refused to send (each reported as it happened).
     pub failed: u64,
+    /// How long after their input arrived the published alerts were in the service; `None`
+    /// when none was published.
+    pub in_service: Option<DelaySpread>,
 }
 
 /// Where an [`AlertSink`] leaves its [`PublisherSummary`] when it finishes, for whoever

@@ -159,6 +159,7 @@ pub struct AlertPublisher {
     wake: iceoryx2::port::notifier::Notifier<Shared>,
     published: u64,
     failed: u64,
+    in_service: super::delay::PublishDelays,
     /// Closing it ends the keeper thread.
     stop_keeper: mpsc::SyncSender<()>,
     keeper: std::thread::JoinHandle<()>,
@@ -224,6 +225,7 @@ impl AlertPublisher {
             wake,
             published: 0,
             failed: 0,
+            in_service: Default::default(),
             stop_keeper,
             keeper,
             _service: service,
@@ -231,10 +233,14 @@ impl AlertPublisher {
         })
     }
 
-    /// Publishes one alert and wakes the subscribers; the error names the alert and why.
+    /// Publishes one alert and wakes the subscribers; the error names the alert and why. How
+    /// long after its input the alert was in the service is recorded before the wake-up.
     pub fn send(&mut self, alert: Alert) -> Result<(), AlertError> {
         match self.publisher.send_copy(alert) {
             Ok(_) => {
+                let in_service_ns = crate::clock::wall_clock_now_ns();
+                self.in_service
+                    .record(in_service_ns.saturating_sub(alert.wall_time_ns));
                 self.published += 1;
                 let _ = self.wake.notify();
                 Ok(())
@@ -261,6 +267,7 @@ impl AlertPublisher {
         PublisherSummary {
             published: self.published,
             failed: self.failed,
+            in_service: self.in_service.spread(),
         }
     }
 }
@@ -557,6 +564,11 @@ mod tests {
         let summary = publisher.finish();
         assert_eq!(summary.published, total);
         assert_eq!(summary.failed, 0);
+        assert_eq!(
+            summary.in_service.map(|d| d.alerts),
+            Some(total),
+            "each published alert's time to the service counted"
+        );
         let received = drain(&mut subscriber);
         // The buffer kept the newest alerts; the oldest were overwritten and are reported.
         assert_eq!(
