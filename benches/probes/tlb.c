@@ -12,26 +12,16 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
-#include <time.h>
 #include <unistd.h>
+
+#include "probe.h"
 
 #define REPS 300
 
-static long long now_ns(void) {
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return t.tv_sec * 1000000000LL + t.tv_nsec;
-}
-
-static int by_value(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return x < y ? -1 : x > y;
-}
-
-static double sweep_us(volatile char *buffer, size_t size, size_t stride) {
+static long long sweep_ns(volatile char *buffer, size_t size, size_t stride) {
     long long start = now_ns();
     for (size_t i = 0; i < size; i += stride) buffer[i]++;
-    return (now_ns() - start) / 1e3;
+    return now_ns() - start;
 }
 
 int main(int argc, char **argv) {
@@ -55,31 +45,31 @@ int main(int argc, char **argv) {
         _exit(0);
     }
     close(there[0]);
-    double warm[REPS], slept[REPS], switched[REPS];
+    long long warm[REPS], slept[REPS], switched[REPS];
     for (int i = 0; i < REPS; i++) {
-        sweep_us(buffer, size, stride);
-        warm[i] = sweep_us(buffer, size, stride);
+        sweep_ns(buffer, size, stride);
+        warm[i] = sweep_ns(buffer, size, stride);
     }
     for (int i = 0; i < REPS; i++) {
-        sweep_us(buffer, size, stride);
+        sweep_ns(buffer, size, stride);
         usleep(5000);
-        slept[i] = sweep_us(buffer, size, stride);
+        slept[i] = sweep_ns(buffer, size, stride);
     }
     for (int i = 0; i < REPS; i++) {
-        sweep_us(buffer, size, stride);
+        sweep_ns(buffer, size, stride);
         char byte = 'x';
         write(there[1], &byte, 1);
         read(back[0], &byte, 1);
-        switched[i] = sweep_us(buffer, size, stride);
+        switched[i] = sweep_ns(buffer, size, stride);
     }
     close(there[1]);
     wait(0);
-    qsort(warm, REPS, sizeof(double), by_value);
-    qsort(slept, REPS, sizeof(double), by_value);
-    qsort(switched, REPS, sizeof(double), by_value);
+    qsort(warm, REPS, sizeof(long long), by_value);
+    qsort(slept, REPS, sizeof(long long), by_value);
+    qsort(switched, REPS, sizeof(long long), by_value);
     printf("%zu KB, a touch every %zu B: warm p50 %.1f | after a 5 ms sleep p50 %.1f p90 %.1f | "
            "right after a switch to another process p50 %.1f p90 %.1f us\n",
-           size >> 10, stride, warm[REPS / 2], slept[REPS / 2], slept[REPS * 9 / 10],
-           switched[REPS / 2], switched[REPS * 9 / 10]);
+           size >> 10, stride, warm[REPS / 2] / 1e3, slept[REPS / 2] / 1e3,
+           slept[REPS * 9 / 10] / 1e3, switched[REPS / 2] / 1e3, switched[REPS * 9 / 10] / 1e3);
     return 0;
 }
