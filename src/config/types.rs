@@ -354,8 +354,8 @@ pub struct OutputConfig {
     /// `/dev/cpu_dma_latency`); `None`: the kernel's idle policy.
     #[serde(default)]
     pub cpu_wakeup_latency_us: Option<u32>,
-    /// Idle CPUs kept awake (PM QoS 0 µs) while a block is analysed, so that the alert's
-    /// subscriber wakes on a CPU that is already awake.
+    /// Idle CPUs kept awake (PM QoS 0 µs) from a block's hand-over to the analysis until it
+    /// is analysed, so that the alert's subscriber wakes on a CPU that is already awake.
     #[serde(default = "default_cpu_awake_during_analysis")]
     pub cpu_awake_during_analysis: bool,
 }

@@ -58,7 +58,7 @@ use crate::sources::live::{can_interfaces, shm_sensors};
 #[cfg(any(feature = "can", feature = "shm"))]
 use crate::sources::live::{forward, SENSOR_TIMEOUT};
 use crate::sources::sim::SimSource;
-use crate::sources::Arrived;
+use crate::sources::{AnalysisInbox, Arrived, HandOverWatch};
 use std::path::{Path, PathBuf};
 use std::sync::{mpsc, Arc};
 use std::time::Duration;
@@ -189,6 +189,14 @@ pub async fn run(
     let sink = spawn("sink", move || sink_thread(queued, &sink_rx))?;
     let worker = TwinWorker::new(&config.twin, learned);
     let refit = spawn("twin", move || refit_thread(worker, &request_rx, &fit_tx))?;
+    let cpus_awake = cpus_awake_during_analysis(&config, options.realtime, &events);
+    // The sources wake the idle CPUs as they hand a block over; the analysis lets them halt.
+    let inputs = AnalysisInbox::new(
+        input_tx,
+        cpus_awake
+            .clone()
+            .map(|cpus| Arc::new(cpus) as Arc<dyn HandOverWatch>),
+    );
     let analysis = AnalysisThread {
         pipeline,
         sinks: SinkEnds {
@@ -205,7 +213,7 @@ pub async fn run(
         state_every: Duration::from_secs_f64(config.outputs.state_save_interval_s),
         state_saved: std::time::Instant::now(),
         events: events.clone(),
-        cpus_awake: cpus_awake_during_analysis(&config, options.realtime, &events),
+        cpus_awake: cpus_awake.clone(),
     };
     let analysis = spawn("analysis", move || analysis.run())?;
 
@@ -214,16 +222,16 @@ pub async fn run(
     let live = start_live_sources(
         &config,
         can_sources,
-        &input_tx,
+        &inputs,
         &stop_rx,
         &mut sources,
         &events,
     )?;
-    start_simulated(&config, &options, &input_tx, &stop_rx, &mut sources);
+    start_simulated(&config, &options, &inputs, &stop_rx, &mut sources);
     // A weak handle on the analysis queue, to see whether inputs wait there; it does not keep
     // the queue open, so the analysis thread still ends when the sources do.
-    let analysis_queue = input_tx.downgrade();
-    drop(input_tx);
+    let analysis_queue = inputs.downgrade();
+    drop(inputs);
 
     supervise(
         &config,
@@ -421,7 +429,7 @@ fn open_can_sources(config: &Config) -> Result<Vec<OpenedCan>, RunError> {
 fn start_live_sources(
     config: &Config,
     can_sources: Vec<OpenedCan>,
-    inputs: &async_mpsc::Sender<Arrived>,
+    inputs: &AnalysisInbox,
     stop: &watch::Receiver<bool>,
     tasks: &mut JoinSet<()>,
     events: &Events,
@@ -510,7 +518,7 @@ fn start_live_sources(
 fn start_simulated(
     config: &Config,
     options: &RunOptions,
-    inputs: &async_mpsc::Sender<Arrived>,
+    inputs: &AnalysisInbox,
     stop: &watch::Receiver<bool>,
     tasks: &mut JoinSet<()>,
 ) {
@@ -543,7 +551,7 @@ fn start_simulated(
 /// either way: only when they are handed over changes.
 async fn feed_simulated(
     mut sims: Vec<SimSource>,
-    tx: async_mpsc::Sender<Arrived>,
+    inputs: AnalysisInbox,
     options: RunOptions,
     mut stop: watch::Receiver<bool>,
 ) {
@@ -569,7 +577,7 @@ async fn feed_simulated(
         };
         for sim in sims.get_mut(due).into_iter().flatten() {
             for input in sim.next_blocks() {
-                if tx.send(Arrived::now(input)).await.is_err() {
+                if !inputs.hand_over(input).await {
                     return;
                 }
             }

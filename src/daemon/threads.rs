@@ -118,20 +118,19 @@ impl AnalysisThread {
     /// they come, then, in their order, to the sink queue.
     fn analyse(&mut self, arrived: Arrived) {
         let Arrived { input, wall_ns } = arrived;
-        self.keep_cpus_awake(true);
         self.deliver(wall_ns, |pipeline, mut out| {
             pipeline.handle(input, &mut out)
         });
-        self.keep_cpus_awake(false);
+        self.let_cpus_halt();
     }
 
-    /// Wakes the idle CPUs for a block's analysis (`true`) or lets them halt again (`false`);
-    /// a request the kernel refuses is said once and not made again.
-    fn keep_cpus_awake(&mut self, awake: bool) {
-        let Some(cpus) = self.cpus_awake.as_mut() else {
+    /// The input is analysed: the idle CPUs, woken when it was handed over, may halt again once
+    /// every input handed over is; a request the kernel refuses is said once and not made again.
+    fn let_cpus_halt(&mut self) {
+        let Some(cpus) = self.cpus_awake.as_ref() else {
             return;
         };
-        if let Err(error) = cpus.set(awake) {
+        if let Some(error) = cpus.analysed() {
             self.cpus_awake = None;
             (self.events)(DaemonEvent::CpuLatencyRefused(error));
         }
@@ -434,14 +433,17 @@ mod tests {
     }
 
     #[test]
-    fn a_block_is_analysed_with_the_cpus_awake_and_they_may_halt_after_it() {
+    fn the_cpus_woken_at_the_hand_over_may_halt_once_the_block_is_analysed() {
+        use crate::sources::HandOverWatch as _;
         let (queue, _queued) = mpsc::sync_channel(SINK_QUEUE);
         let mut thread = analysis_thread(Box::new(Discarding), queue);
         let device = bearingd_testdata::scratch_dir("cpus-awake").join("cpu_dma_latency");
         std::fs::write(&device, b"").unwrap();
-        thread.cpus_awake = Some(CpusAwake::open(&device).unwrap());
+        let cpus = CpusAwake::open(&device).unwrap();
+        thread.cpus_awake = Some(cpus.clone());
+        cpus.handed_over();
         thread.analyse(sensor_lost());
-        // What the PM QoS device was told, in order: 0 µs for the block, then no constraint.
+        // What the PM QoS device was told, in order: 0 µs at the hand-over, then no constraint.
         let told = std::fs::read(&device).unwrap();
         assert_eq!(told[..4], 0i32.to_ne_bytes());
         assert_eq!(told[4..], 2_000_000_000i32.to_ne_bytes());
@@ -449,13 +451,17 @@ mod tests {
 
     #[test]
     fn a_refused_awake_request_is_said_once_and_not_made_again() {
+        use crate::sources::HandOverWatch as _;
         let (queue, _queued) = mpsc::sync_channel(SINK_QUEUE);
         let mut thread = analysis_thread(Box::new(Discarding), queue);
         let (events, kept) = crate::daemon::events::kept_events();
         thread.events = events;
         // Every write to /dev/full fails (no space).
-        thread.cpus_awake = Some(CpusAwake::open(std::path::Path::new("/dev/full")).unwrap());
+        let cpus = CpusAwake::open(std::path::Path::new("/dev/full")).unwrap();
+        thread.cpus_awake = Some(cpus.clone());
+        cpus.handed_over();
         thread.analyse(sensor_lost());
+        cpus.handed_over();
         thread.analyse(sensor_lost());
         assert!(thread.cpus_awake.is_none());
         let kept = kept.lock().unwrap();

@@ -10,6 +10,7 @@ use crate::config::{Config, SensorConfig, Transport};
 use crate::messages::{ChannelId, IngestMessage};
 use crate::pipeline::Input;
 use std::collections::BTreeMap;
+use std::sync::Arc;
 use std::time::Duration;
 
 /// How long a node may stay silent before it is reported lost.
@@ -124,6 +125,46 @@ impl Arrived {
     }
 }
 
+/// Told of each input once it is in the analysis queue: `run` wakes the idle CPUs there
+/// (`daemon::cpu_latency`), on the source's time rather than the analysis'.
+pub trait HandOverWatch: Send + Sync {
+    fn handed_over(&self);
+}
+
+/// The sources' end of the analysis queue: stamps each input as it arrives ([`Arrived`]),
+/// waits while the queue is full (no input is dropped here), then tells the watch, if any.
+/// Every input reaches the analysis through it, so the watch hears of each one.
+#[derive(Clone)]
+pub struct AnalysisInbox {
+    queue: tokio::sync::mpsc::Sender<Arrived>,
+    watch: Option<Arc<dyn HandOverWatch>>,
+}
+
+impl AnalysisInbox {
+    pub fn new(
+        queue: tokio::sync::mpsc::Sender<Arrived>,
+        watch: Option<Arc<dyn HandOverWatch>>,
+    ) -> AnalysisInbox {
+        AnalysisInbox { queue, watch }
+    }
+
+    /// Hands `input` over; `false` once the analysis has ended (the input is not taken).
+    pub async fn hand_over(&self, input: Input) -> bool {
+        if self.queue.send(Arrived::now(input)).await.is_err() {
+            return false;
+        }
+        if let Some(watch) = &self.watch {
+            watch.handed_over();
+        }
+        true
+    }
+
+    /// A handle that sees whether inputs wait in the queue without keeping it open.
+    pub fn downgrade(&self) -> tokio::sync::mpsc::WeakSender<Arrived> {
+        self.queue.downgrade()
+    }
+}
+
 /// Forwards a source's events to the analysis queue until either side ends. Sample blocks of
 /// nodes or axes the config does not know are skipped and counted; the source's counters
 /// ([`IngestEvent::Stats`]) go on as [`Input::Ingest`] for the log, named `source`.
@@ -131,7 +172,7 @@ pub async fn forward(
     mut events: tokio::sync::mpsc::Receiver<IngestEvent>,
     map: NodeMap,
     source: String,
-    inputs: tokio::sync::mpsc::Sender<Arrived>,
+    inputs: AnalysisInbox,
 ) {
     let mut dropped_blocks = 0u64;
     while let Some(event) = events.recv().await {
@@ -149,7 +190,7 @@ pub async fn forward(
             other => map.to_input(other),
         };
         if let Some(input) = input {
-            if inputs.send(Arrived::now(input)).await.is_err() {
+            if !inputs.hand_over(input).await {
                 return;
             }
         }
@@ -170,5 +211,61 @@ pub fn ingest_message(source: &str, stats: &IngestStats, dropped_blocks: u64) ->
         speed_frames: stats.speed_frames,
         sensor_lost: stats.sensor_lost,
         handoff_dropped: stats.handoff_dropped,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// Counts the hand-overs, and what the queue held when each was told.
+    #[derive(Default)]
+    struct Counting {
+        told: AtomicUsize,
+        queued_when_told: AtomicUsize,
+        queue: std::sync::OnceLock<tokio::sync::mpsc::WeakSender<Arrived>>,
+    }
+
+    impl HandOverWatch for Counting {
+        fn handed_over(&self) {
+            self.told.fetch_add(1, Ordering::SeqCst);
+            let queued = self
+                .queue
+                .get()
+                .and_then(|q| q.upgrade())
+                .map_or(0, |q| q.max_capacity() - q.capacity());
+            self.queued_when_told.store(queued, Ordering::SeqCst);
+        }
+    }
+
+    fn lost() -> Input {
+        Input::SensorLost {
+            sensor: "motor-de".into(),
+        }
+    }
+
+    #[tokio::test]
+    async fn the_watch_hears_of_an_input_once_it_is_in_the_queue() {
+        let (queue, mut taken) = tokio::sync::mpsc::channel(4);
+        let watch = Arc::new(Counting::default());
+        let _ = watch.queue.set(queue.downgrade());
+        let inbox = AnalysisInbox::new(queue, Some(watch.clone() as Arc<dyn HandOverWatch>));
+        assert!(inbox.hand_over(lost()).await);
+        assert_eq!(watch.told.load(Ordering::SeqCst), 1);
+        assert_eq!(watch.queued_when_told.load(Ordering::SeqCst), 1);
+        let arrived = taken.recv().await.expect("the input");
+        assert!(matches!(arrived.input, Input::SensorLost { .. }));
+        assert!(arrived.wall_ns > 0, "stamped as it arrived");
+    }
+
+    #[tokio::test]
+    async fn an_input_the_ended_analysis_cannot_take_is_not_told() {
+        let (queue, taken) = tokio::sync::mpsc::channel(4);
+        drop(taken);
+        let watch = Arc::new(Counting::default());
+        let inbox = AnalysisInbox::new(queue, Some(watch.clone() as Arc<dyn HandOverWatch>));
+        assert!(!inbox.hand_over(lost()).await);
+        assert_eq!(watch.told.load(Ordering::SeqCst), 0);
     }
 }

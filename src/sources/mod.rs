@@ -4,7 +4,8 @@
 //!   events onto the config's channels for `bearingd run`.
 //! - [`sim`]: the in-process simulated sensor node (the twin's signal model).
 //! - [`replay`]: the raw samples and measured speeds of MCAP logs.
-//! - [`Arrived`]: an input with the wall-clock time it arrived ([`crate::clock`]).
+//! - [`Arrived`]: an input with the wall-clock time it arrived ([`crate::clock`]), handed to the
+//!   analysis through an [`AnalysisInbox`].
 //!
 //! Why this module exists apart from the analysis core: the core is sans-IO (no socket, no
 //! clock, no async runtime), so something must own the sockets, the shared memory, the
@@ -40,7 +41,7 @@ pub mod sim;
 pub use assemble::{
     Assembler, IngestEvent, IngestStats, MalformedCounts, MalformedKind, SampleBlock, StreamSummary,
 };
-pub use live::Arrived;
+pub use live::{AnalysisInbox, Arrived, HandOverWatch};
 
 use std::collections::BTreeMap;
 use std::time::Duration;
