@@ -213,7 +213,7 @@ pub async fn run(
         state_every: Duration::from_secs_f64(config.outputs.state_save_interval_s),
         state_saved: std::time::Instant::now(),
         events: events.clone(),
-        cpus_awake: cpus_awake.clone(),
+        cpus_awake,
     };
     let analysis = spawn("analysis", move || analysis.run())?;
 
