@@ -38,6 +38,9 @@
 //! `outputs.cpu_awake_during_analysis = false` (`true`): idle CPUs woken for each block's
 //! analysis or not; left out by default, as in the default config (on). Both need write access to `/dev/cpu_dma_latency`:
 //! the summary line says when this user has none (the daemon then runs without them).
+//! The daemon runs with the systemd unit's `GLIBC_TUNABLES` (its heap in huge pages,
+//! `bearingd::daemon::heap_pages`), as installed; `BENCH_HEAP_TUNABLES=0` leaves the bench's
+//! environment as it is (4 KiB pages unless it sets them), for a before/after comparison.
 //!
 //! A line says how the alerts came per input ([`InputGroups`]): alone, or several from
 //! one input, and how far apart; one per round, the daemon's own part of the latency
@@ -184,6 +187,8 @@ fn main() {
     );
     let daemon_path = std::env::var("BENCH_BEARINGD")
         .unwrap_or_else(|_| env!("CARGO_BIN_EXE_bearingd").to_string());
+    let heap_tunables = (std::env::var("BENCH_HEAP_TUNABLES").as_deref() != Ok("0"))
+        .then_some(bearingd::daemon::heap_pages::HEAP_TUNABLES);
     let mut latencies_ms = Vec::new();
     // The alerts of the bearing-fault flags alone: each follows a band selection's verdict,
     // the path of the alerts a maintenance engineer acts on (the rest are per-window flags).
@@ -211,6 +216,7 @@ fn main() {
             ])
             .arg(&config)
             .env("BEARINGD_IOX_PREFIX", &prefix)
+            .envs(heap_tunables.map(|value| ("GLIBC_TUNABLES", value)))
             .stdout(std::fs::File::create(&daemon_out).expect("daemon output file"))
             .spawn()
             .expect("start bearingd");
@@ -269,7 +275,7 @@ fn main() {
     assert!(!latencies_ms.is_empty(), "no alert arrived");
     latencies_ms.sort_by(f64::total_cmp);
     println!(
-        "alert latency, {sensors} sensors at {rate} Hz, {rounds} round(s){}, {}: {} alerts ({lost} lost), \
+        "alert latency, {sensors} sensors at {rate} Hz, {rounds} round(s){}, {}, heap {}: {} alerts ({lost} lost), \
          p50 {:.2} ms, p99 {:.2} ms, p999 {:.2} ms, max {:.2} ms, min {:.2} ms",
         if chatter {
             format!(", {duration_s} s = {windows}+ windows, chattering flags")
@@ -277,6 +283,10 @@ fn main() {
             String::new()
         },
         cpu_requests(cpu, writable, device),
+        match heap_tunables {
+            Some(_) => "with the unit's GLIBC_TUNABLES",
+            None => "as the bench's environment gives it",
+        },
         latencies_ms.len(),
         percentile(&latencies_ms, 50.0),
         percentile(&latencies_ms, 99.0),

@@ -7,7 +7,9 @@
 #   scripts/bench_capacity.sh [CHANNELS=64] [SECONDS=40] [CORE=0|none]
 #
 # BIN overrides the binary (default target/release/bearingd); HW=off turns the online
-# Hammerstein–Wiener model off (twin.hw_enabled = false), to see what it costs.
+# Hammerstein–Wiener model off (twin.hw_enabled = false), to see what it costs. The daemon runs
+# with the systemd unit's GLIBC_TUNABLES (its heap in huge pages), as installed; HEAP=4k runs
+# it with the environment as it is.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 channels="${1:-64}" seconds="${2:-40}" core="${3:-0}"
@@ -32,9 +34,13 @@ echo "dir: $dir"
     "$dir" "$dir" "$dir" "$$"
 } > "$dir/config.toml"
 "$bin" validate "$dir/config.toml" >/dev/null
+if [ "${HEAP:-huge}" != 4k ]; then
+  GLIBC_TUNABLES=$(sed -n 's/^Environment=GLIBC_TUNABLES=//p' systemd/bearingd.service)
+  export GLIBC_TUNABLES
+fi
 pin=()
 [ "$core" != none ] && pin=(taskset -c "$core")
-echo "== $channels channels × 25.6 kHz, HW model ${HW:-on}, $seconds s of signal, core ${core}, load $(cut -d' ' -f1-3 /proc/loadavg)"
+echo "== $channels channels × 25.6 kHz, HW model ${HW:-on}, heap ${HEAP:-huge}, $seconds s of signal, core ${core}, load $(cut -d' ' -f1-3 /proc/loadavg)"
 "${pin[@]}" /usr/bin/time -v "$bin" run --config "$dir/config.toml" --duration "$seconds" --quiet \
   2> "$dir/stderr" > "$dir/stdout" || { tail -20 "$dir/stderr"; exit 1; }
 grep -iE "fit|dropped|summary" "$dir/stderr" "$dir/stdout" | sed 's/^[^:]*://' | tail -8

@@ -374,6 +374,13 @@ pub(super) fn event_line(event: &DaemonEvent) -> String {
              (outputs.cpu_wakeup_latency_us)"
         ),
         DaemonEvent::CpuLatencyRefused(error) => format!("bearingd: warning: {error}"),
+        DaemonEvent::HeapInSmallPages { missing } => format!(
+            "bearingd: note: the analysis' memory is in 4 KiB pages (GLIBC_TUNABLES lacks {}); \
+             on a VM whose host reclaims idle memory an alert can wait milliseconds for it. \
+             Start bearingd with GLIBC_TUNABLES={}, as the systemd unit does (docs/PERFORMANCE.md)",
+            missing.join(":"),
+            crate::daemon::heap_pages::HEAP_TUNABLES
+        ),
         DaemonEvent::IoxRootTightened { root, from } => format!(
             "bearingd: iceoryx2 root {} was mode {from:04o}: now 0700 (only bearingd's user may use it)",
             root.display()

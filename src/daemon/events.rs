@@ -55,6 +55,10 @@ pub enum DaemonEvent {
     /// `outputs.cpu_awake_during_analysis` at the start or later) could not be held; bearingd
     /// runs on without it.
     CpuLatencyRefused(super::cpu_latency::CpuLatencyError),
+    /// The kernel gives transparent huge pages but glibc was not told to put the heap in them:
+    /// these `GLIBC_TUNABLES` are missing ([`super::heap_pages`]). Said once, at the start of
+    /// a run at real time.
+    HeapInSmallPages { missing: Vec<&'static str> },
     /// The iceoryx2 root was this user's but readable by others (made by an earlier bearingd
     /// or by iceoryx2, `0750`): it is now `0700`.
     IoxRootTightened { root: PathBuf, from: u32 },

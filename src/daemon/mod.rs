@@ -8,11 +8,14 @@
 //! - [`events`]: what the daemon tells its operator, as typed events for the caller to show
 //!   (the daemon never prints).
 //! - [`cpu_latency`]: the CPUs' wake-up latency held down while it runs (an alert's latency).
+//! - [`heap_pages`]: whether the analysis' memory can be in huge pages (an alert's latency on
+//!   a VM), and what to set if not.
 //! - [`lock`]: one owner per data directory (an advisory lock taken before anything is opened).
 //! - [`state`]: what is kept across restarts (the health baselines).
 
 pub mod cpu_latency;
 pub mod events;
+pub mod heap_pages;
 pub mod lock;
 pub mod replay;
 pub mod run;

@@ -42,6 +42,7 @@
 
 use super::cpu_latency::{CpuLatencyCap, CpusAwake, CPU_LATENCY_DEVICE};
 use super::events::{DaemonEvent, Events};
+use super::heap_pages::{self, HeapPages};
 use super::lock::{DirLock, LockError};
 use super::sinks::{assemble, SinkPlan, SinkStart, SinkStartError, Sinks};
 use super::state::load_baselines;
@@ -190,6 +191,11 @@ pub async fn run(
     let worker = TwinWorker::new(&config.twin, learned);
     let refit = spawn("twin", move || refit_thread(worker, &request_rx, &fit_tx))?;
     let cpus_awake = cpus_awake_during_analysis(&config, options.realtime, &events);
+    if options.realtime {
+        if let HeapPages::Small { missing } = heap_pages::this_process() {
+            events(DaemonEvent::HeapInSmallPages { missing });
+        }
+    }
     // The sources wake the idle CPUs as they hand a block over; the analysis lets them halt.
     let inputs = AnalysisInbox::new(
         input_tx,

@@ -52,6 +52,20 @@ else
   verdict cpu-latency FAIL "pid $pid, device $(stat -c '%U:%G %a' /dev/cpu_dma_latency 2>&1), journal: ${capped:-no line on the wake-up latency}"
 fi
 
+# 1c. The unit's GLIBC_TUNABLES (the heap in huge pages) reach bearingd: systemd passes them,
+#     and bearingd, which names what is missing when the kernel gives huge pages and glibc is
+#     not told (src/daemon/heap_pages.rs), says nothing of 4 KiB pages. (Not read from
+#     /proc/PID/environ: glibc 2.36 cuts the variable there at the first ':' as it parses it;
+#     the process' own environment keeps the whole value.)
+tunables=$(systemctl show -p Environment --value bearingd | tr ' ' '\n' | grep -a '^GLIBC_TUNABLES=')
+note=$(journalctl -u bearingd --no-pager -o cat 2>/dev/null | grep -a -m1 '4 KiB pages')
+thp=$(cat /sys/kernel/mm/transparent_hugepage/enabled 2>/dev/null || echo "none")
+if echo "$tunables" | grep -q 'glibc.malloc.hugetlb=1:glibc.malloc.mmap_threshold=' && [ -z "$note" ]; then
+  verdict heap-pages PASS "$tunables; kernel THP: $thp; no note on 4 KiB pages"
+else
+  verdict heap-pages FAIL "unit environment: ${tunables:-no GLIBC_TUNABLES}; kernel THP: $thp; journal: ${note:-nothing}"
+fi
+
 # 2. An alert over iceoryx2, received by the command-line subscriber run as user bearingd (as
 #    an operator would: runuser -u bearingd -- bearingd alerts). iceoryx2 0.10 creates its
 #    files owner-only, so the daemon (no capabilities) cannot connect to a root subscriber;

@@ -10,6 +10,8 @@
 #   active     bearingd reached "active" (Type=notify: READY=1 sent) and reports STATUS=
 #   cpu-latency  bearingd holds /dev/cpu_dma_latency open (outputs.cpu_wakeup_latency_us = 50)
 #              through the unit's sandbox, the device's group set by the installed tmpfiles.d
+#   heap-pages systemd passes the unit's GLIBC_TUNABLES (the heap in huge pages) to bearingd,
+#              which says nothing of 4 KiB pages
 #   alert-root-refused  `bearingd alerts` started as root exits 2 with the runuser fix
 #   alert      `bearingd alerts --json --count 1`, as user bearingd, received the outer-race
 #              alert, state "raised"
@@ -237,7 +239,7 @@ echo "VMTEST mcap: $mcap_ok $mcap_detail" | tee -a "$WORK/host-verdicts.log"
 # 9. Verdict: every expected line present, none failed.
 status=0
 cat "$WORK/host-verdicts.log" >> "$WORK/serial.txt"
-for check in install active cpu-latency alert-root-refused alert alert-history status-flag stop mcap-sent mcap; do
+for check in install active cpu-latency heap-pages alert-root-refused alert alert-history status-flag stop mcap-sent mcap; do
   line=$(grep -a -m1 "^VMTEST $check: " "$WORK/serial.txt" || true)
   case "$line" in
     "VMTEST $check: PASS"*) ;;
