@@ -196,7 +196,8 @@ impl CpusAwake {
     /// A block is analysed: the CPUs may halt again once every block handed over is. Returns
     /// the first refused write, of either end, once: the caller says it.
     pub fn analysed(&self) -> Option<CpuLatencyError> {
-        self.with(|request| {
+        let mut request = self.lock();
+        request.unless_refused(|request| {
             request.analysed += 1;
             if request.tight && request.analysed >= request.handed_over {
                 request.write(UNCONSTRAINED_US)?;
@@ -204,20 +205,7 @@ impl CpusAwake {
             }
             Ok(())
         });
-        self.lock().unsaid.take()
-    }
-
-    /// Runs `step` on the request unless a write was refused before; a refusal ends the
-    /// requests and waits to be said.
-    fn with(&self, step: impl FnOnce(&mut AwakeRequest) -> Result<(), CpuLatencyError>) {
-        let mut request = self.lock();
-        if request.refused {
-            return;
-        }
-        if let Err(error) = step(&mut request) {
-            request.refused = true;
-            request.unsaid = Some(error);
-        }
+        request.unsaid.take()
     }
 
     /// The request. A thread that panicked holding it left it usable (each step writes
@@ -230,7 +218,7 @@ impl CpusAwake {
 impl HandOverWatch for CpusAwake {
     /// A block is in the analysis queue: the idle CPUs are woken unless it is analysed already.
     fn handed_over(&self) {
-        self.with(|request| {
+        self.lock().unless_refused(|request| {
             request.handed_over += 1;
             if !request.tight && request.analysed < request.handed_over {
                 request.write(0)?;
@@ -242,6 +230,18 @@ impl HandOverWatch for CpusAwake {
 }
 
 impl AwakeRequest {
+    /// Runs `step` unless a write was refused before; a refusal ends the requests and waits
+    /// to be said.
+    fn unless_refused(&mut self, step: impl FnOnce(&mut Self) -> Result<(), CpuLatencyError>) {
+        if self.refused {
+            return;
+        }
+        if let Err(error) = step(self) {
+            self.refused = true;
+            self.unsaid = Some(error);
+        }
+    }
+
     fn write(&mut self, latency_us: i32) -> Result<(), CpuLatencyError> {
         write_request(&mut self.file, latency_us).map_err(refused(
             CpuLatencyRequest::AwakeDuringAnalysis,
